@@ -1,0 +1,34 @@
+# Two commands from a fresh clone: `make demo` and `make test`. Everything installs into .venv.
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+export TI_SKIP_VERSION_CHECK := ON
+
+.PHONY: demo test presets accuracy bench batch clean
+
+$(BIN)/pendulum: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+demo: $(BIN)/pendulum
+	$(BIN)/pendulum render rigid_chaos
+
+test: $(BIN)/pendulum
+	$(BIN)/python -m pytest
+
+presets: $(BIN)/pendulum
+	$(BIN)/pendulum presets
+
+accuracy: $(BIN)/pendulum
+	$(BIN)/pendulum accuracy
+
+bench: $(BIN)/pendulum
+	$(BIN)/pendulum bench
+
+batch: $(BIN)/pendulum
+	$(BIN)/pendulum batch
+
+clean:
+	rm -rf $(VENV) out/*/ out/index.html *.egg-info

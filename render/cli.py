@@ -1,0 +1,149 @@
+"""The `pendulum` command. Exit codes: 0 ok, 1 failure while running, 2 bad input, 130/143 interrupted."""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import signal
+import sys
+from pathlib import Path
+
+from .scene import SceneError
+
+# Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
+MODULES: tuple[str, ...] = ()
+
+
+class Terminated(BaseException):
+    """SIGTERM, turned into an exception so every `finally`/cleanup runs."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2 (argparse prints usage too by default)
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
+               epilog="Presets live in presets/*.toml; see README.md for the format.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+
+    r = sub.add_parser("render", help="render presets to out/NAME/ (MP4, GIF, metadata.json)",
+                       description="Simulate each preset, draw every frame offscreen and encode MP4 and GIF "
+                                   "into OUT/NAME/ with a metadata.json.")
+    r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
+    add_common(r)
+    r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    r.add_argument("--quality", choices=("draft", "standard", "high", "reference"),
+                   help="integrator (method, dt, precision) by accuracy level; overrides the preset's")
+    r.add_argument("--threads", type=int, default=None, help="CPU threads for Taichi (default: all cores)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.set_defaults(func=cmd_render)
+
+    s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",
+                       description="Write t, the state (theta/omega or pos/vel) and energy at every frame time.")
+    s.add_argument("preset", metavar="PRESET")
+    s.add_argument("--out", type=Path, required=True, metavar="FILE.npz")
+    add_common(s)
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.set_defaults(func=cmd_simulate)
+
+    ls = sub.add_parser("presets", help="list the presets, one line each")
+    ls.set_defaults(func=cmd_presets)
+
+    for name in MODULES:
+        importlib.import_module(f"render.{name}").add_parser(sub)
+    return p
+
+
+def add_common(p):
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a preset key, dotted, value in TOML (e.g. --set integrator.dt=1e-4); repeatable")
+    p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu",
+                   help="Taichi backend; cuda falls back to the CPU with a warning where there is none")
+
+
+def check_writable(path: Path, what: str = "--out"):
+    """Bad input if the output cannot be created; checked before any work so nothing is half-written."""
+    probe = path
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
+        raise SceneError(f"{what} {path}: not a writable directory ({probe})")
+
+
+def progress_wanted(args) -> bool:
+    return not args.no_progress and sys.stderr.isatty()
+
+
+def cmd_render(args) -> int:
+    from . import pipeline
+    from .scene import load
+
+    scenes = [load(p, args.overrides, args.quality) for p in args.presets]  # all validated before any work
+    check_writable(args.out)
+    for scene in scenes:
+        meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),
+                               threads=args.threads)
+        print(summary(meta, args.out / scene.name))
+    return 0
+
+
+def summary(meta: dict, out_dir: Path) -> str:
+    i, t = meta["integrator"], meta["timings_s"]
+    drift = meta["energy"]["max_rel_drift"] if meta["energy"] else None
+    drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
+    return (f"{meta['preset']['name']}: {meta['frames']} frames {meta['width']}x{meta['height']}@{meta['fps']} | "
+            f"{i['method']} dt={i['dt']:.3g}s x{i['substeps']} {i['precision']}{drift_s} | "
+            f"simulate {t['simulate']:.2f}s draw {t['draw']:.2f}s encode {t['encode']:.2f}s "
+            f"total {t['total']:.2f}s -> {out_dir}/")
+
+
+def cmd_simulate(args) -> int:
+    from . import pipeline
+    from .scene import load
+
+    scene = load(args.preset, args.overrides)
+    if args.out.suffix != ".npz":
+        raise SceneError(f"--out {args.out}: must end in .npz")
+    check_writable(args.out.parent)
+    info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
+    print(f"{scene.name}: {info['frames']} frames -> {args.out}")
+    return 0
+
+
+def cmd_presets(args) -> int:
+    from .scene import list_presets, load
+
+    for path in list_presets():
+        try:
+            s = load(str(path))
+            print(f"{s.name:16s} {s.system:8s} N={s.pendulums.count:<8d} {s.description}")
+        except SceneError as e:
+            print(f"{path.stem:16s} INVALID  {e}")
+    return 0
+
+
+def main(argv=None) -> int:
+    from .encode import EncodeError
+    from .system import SimulationError
+
+    def on_term(signum, frame):
+        raise Terminated()
+
+    signal.signal(signal.SIGTERM, on_term)
+    try:
+        args = build_parser().parse_args(argv)
+        return args.func(args)
+    except SceneError as e:
+        print(f"pendulum: error: {e}", file=sys.stderr)
+        return 2
+    except (SimulationError, EncodeError) as e:
+        print(f"pendulum: failed: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("pendulum: interrupted; no partial output was left", file=sys.stderr)
+        return 130
+    except Terminated:
+        print("pendulum: terminated; no partial output was left", file=sys.stderr)
+        return 143

@@ -1,0 +1,167 @@
+"""Scene -> simulation -> canvas -> encoders: one render, and the draw-free `simulate`."""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__, runtime
+from .system import DEFAULT_MAX_DRIFT
+
+SYSTEMS = {}
+
+
+def make_system(scene):
+    if not SYSTEMS:
+        from .elastic import Elastic
+        from .rigid import Rigid
+        SYSTEMS.update(rigid=Rigid, elastic=Elastic)
+    return SYSTEMS[scene.system](scene)
+
+
+def progress_bar(total: int, desc: str, enabled: bool):
+    from tqdm import tqdm
+    return tqdm(total=total, desc=desc, unit="frame", file=sys.stderr, disable=not enabled, leave=False,
+                dynamic_ncols=True)
+
+
+def frames(scene, sim, timings: dict):
+    """Yield each frame index with the simulation at that frame's time (frame 0 is t=0), watchdog checked."""
+    max_drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
+    for f in range(scene.frames):
+        t = time.perf_counter()
+        if f:
+            sim.advance_frame()
+        if scene.has("energy"):
+            sim.measure_energy(first=f == 0)
+        sim.check(f, max_drift)
+        timings["simulate"] += time.perf_counter() - t
+        yield f
+
+
+@contextmanager
+def output_dir(path: Path):
+    """Create the directory; if it was new and the block fails, remove it again when empty."""
+    existed = path.exists()
+    path.mkdir(parents=True, exist_ok=True)
+    try:
+        yield path
+    except BaseException:
+        if not existed:
+            try:
+                path.rmdir()
+            except OSError:
+                pass
+        raise
+
+
+def write_atomic(path: Path, data: bytes):
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
+           frame_hook=None) -> dict:
+    """Render scene into out_root/NAME/; returns the metadata it wrote. frame_hook(f, frame) sees raw frames."""
+    from .canvas import Canvas
+    from .encode import Encoder
+
+    t_start = time.perf_counter()
+    used = runtime.init(arch, scene.integrator.precision, threads)
+    sim = make_system(scene)  # may refuse an unstable dt (SceneError) before anything is written
+    canvas = Canvas(scene, sim)
+    timings = {"simulate": 0.0, "draw": 0.0, "encode": 0.0}
+    with output_dir(Path(out_root) / scene.name) as out_dir:
+        enc = Encoder(out_dir, scene.name, scene.video)
+        try:
+            with progress_bar(scene.frames, scene.name, progress) as bar:
+                for f in frames(scene, sim, timings):
+                    t = time.perf_counter()
+                    frame = canvas.draw()
+                    timings["draw"] += time.perf_counter() - t
+                    if frame_hook:
+                        frame_hook(f, frame)
+                    t = time.perf_counter()
+                    enc.write(frame)  # blocks only when the encoder is behind
+                    timings["encode"] += time.perf_counter() - t
+                    bar.update()
+            t = time.perf_counter()
+            sizes = enc.close()
+            timings["encode"] += time.perf_counter() - t
+        except BaseException:
+            enc.abort()
+            raise
+        timings["total"] = time.perf_counter() - t_start
+        meta = metadata(scene, sim, used, timings, sizes)
+        write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
+    return meta
+
+
+def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -> dict:
+    """Write the state at every frame time to a .npz (DESIGN.md: t, theta/omega or pos/vel, energy)."""
+    if not scene.has("energy"):
+        scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
+    runtime.init(arch, scene.integrator.precision)
+    sim = make_system(scene)
+    timings = {"simulate": 0.0}
+    rows: dict[str, list] = {"t": [], "energy": []}
+    with progress_bar(scene.frames, scene.name, progress) as bar:
+        for f in frames(scene, sim, timings):
+            rows["t"].append(f / scene.video.fps)
+            rows["energy"].append(sim.e.to_numpy())
+            for k, v in sim.state().items():
+                rows.setdefault(k, []).append(v)
+            bar.update()
+    out_file = Path(out_file)
+    with output_dir(out_file.parent):
+        fd, tmp = tempfile.mkstemp(prefix=f".{out_file.name}.", suffix=".npz", dir=out_file.parent)
+        os.close(fd)
+        try:
+            np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
+            os.chmod(tmp, 0o644)
+            os.replace(tmp, out_file)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings}
+
+
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict) -> dict:
+    import taichi as ti
+    from .encode import ffmpeg_version
+
+    energy = None
+    if scene.has("energy"):
+        energy = {"initial_total": float(sim.e0.to_numpy().sum()), "max_rel_drift": float(sim.drift[None])}
+    v = scene.video
+    return {
+        "preset": scene.to_dict(),
+        "preset_hash": scene.hash(),
+        "source": scene.source,
+        "versions": {"package": __version__, "taichi": ".".join(map(str, ti.__version__)),
+                     "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
+        "arch": arch,
+        "frames": scene.frames, "fps": v.fps, "width": v.width, "height": v.height, "duration": v.duration,
+        "integrator": {"method": scene.integrator.method, "dt": sim.h, "dt_requested": scene.integrator.dt,
+                       "substeps": sim.substeps, "precision": scene.integrator.precision},
+        "effects": list(scene.effects),
+        "kernels": list(runtime.launched),
+        "field_bytes": sum(runtime.allocated.values()),
+        "fields": dict(runtime.allocated),
+        "energy": energy,
+        "timings_s": {k: round(val, 4) for k, val in timings.items()},
+        "outputs": sizes,
+    }

@@ -1,0 +1,64 @@
+"""The rigid double pendulum: Lagrange's equations for θ1'', θ2'' (angles from the downward vertical)."""
+
+import numpy as np
+import taichi as ti
+
+from . import runtime
+from .system import System
+
+
+@ti.data_oriented
+class Rigid(System):
+    D = 2  # q = (θ1, θ2), v = (ω1, ω2)
+    NAME = "rigid"
+
+    def initial_state(self):
+        p = self.scene.pendulums
+        th1, th2 = self.initial_angles()
+        w = np.empty((self.n, 2))
+        w[:, 0], w[:, 1] = p.omega1, p.omega2
+        return np.stack([th1, th2], axis=1), w
+
+    @ti.func
+    def accel(self, q, v):
+        m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.g
+        d = q[0] - q[1]
+        sd, cd = ti.sin(d), ti.cos(d)
+        den = 2.0 * m1 + m2 - m2 * ti.cos(2.0 * d)
+        a1 = (-g * (2.0 * m1 + m2) * ti.sin(q[0]) - m2 * g * ti.sin(q[0] - 2.0 * q[1])
+              - 2.0 * sd * m2 * (v[1] * v[1] * l2 + v[0] * v[0] * l1 * cd)) / (l1 * den)
+        a2 = (2.0 * sd * (v[0] * v[0] * l1 * (m1 + m2) + g * (m1 + m2) * ti.cos(q[0])
+                          + v[1] * v[1] * l2 * m2 * cd)) / (l2 * den)
+        return ti.Vector([a1, a2])
+
+    @ti.func
+    def energy(self, q, v):
+        """Kinetic + gravitational, with the potential's zero at the hanging rest position."""
+        m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.g
+        t = (0.5 * (m1 + m2) * l1 * l1 * v[0] * v[0] + 0.5 * m2 * l2 * l2 * v[1] * v[1]
+             + m2 * l1 * l2 * v[0] * v[1] * ti.cos(q[0] - q[1]))
+        y1 = -l1 * ti.cos(q[0])
+        y2 = y1 - l2 * ti.cos(q[1])
+        return t + m1 * g * (y1 + l1) + m2 * g * (y2 + l1 + l2)
+
+    @ti.func
+    def bobs(self, i: ti.i32):
+        q = self.q[i]
+        p1 = self.l1 * ti.Vector([ti.sin(q[0]), -ti.cos(q[0])])
+        return p1, p1 + self.l2 * ti.Vector([ti.sin(q[1]), -ti.cos(q[1])])
+
+    @ti.kernel
+    def rigid_advance(self, substeps: ti.i32):
+        for i in range(self.n):
+            self.advance_one(i, substeps)
+
+    @ti.kernel
+    def rigid_energy(self, first: ti.i32):
+        for i in range(self.n):
+            self.energy_one(i, first)
+
+    def extent(self) -> float:
+        return self.l1 + self.l2
+
+    def state(self):
+        return {"theta": self.q.to_numpy(), "omega": self.v.to_numpy()}

@@ -1,0 +1,80 @@
+"""One place that owns the Taichi runtime: arch, precision, and the log of kernels launched.
+
+Precision is chosen by re-initialising Taichi with default_fp, not by casting: with default_fp=f64 an f32
+value times a float literal is computed in f64, so "f32" would silently be f64 arithmetic.
+"""
+from __future__ import annotations
+
+import os
+import sys
+import warnings
+
+os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")  # no network look-up at start-up
+os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
+
+import taichi as ti  # noqa: E402
+
+ARCHES = ("cpu", "cuda")
+_current: tuple | None = None
+launched: list[str] = []  # kernel names in first-launch order, since the last init
+
+
+def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) -> str:
+    """(Re)initialise Taichi if the settings differ; returns the arch actually in use."""
+    global _current
+    want = (arch, precision, threads)
+    if _current is not None and _current[0] == want:
+        launched.clear()
+        allocated.clear()
+        return _current[1]
+    kw = dict(default_fp=ti.f64 if precision == "f64" else ti.f32, log_level=ti.ERROR,
+              random_seed=0, offline_cache=True)
+    if threads:
+        kw["cpu_max_num_threads"] = threads
+    used = "cpu"
+    if arch == "cuda":
+        # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
+        ti.init(arch=ti.cuda, **kw)
+        used = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
+        if used == "cpu":
+            print("warning: --arch cuda: no CUDA device found, running on the CPU", file=sys.stderr)
+    else:
+        ti.init(arch=ti.cpu, **kw)
+    _current = (want, used)
+    launched.clear()
+    allocated.clear()
+    return used
+
+
+def real():
+    """The float type of the current init."""
+    return ti.lang.impl.current_cfg().default_fp
+
+
+class Launcher:
+    """Mixin: launch kernels by name so a run can report exactly which kernels it used."""
+
+    def launch(self, name: str, *args):
+        if name not in launched:
+            launched.append(name)
+        return getattr(self, name)(*args)
+
+
+allocated: dict[str, int] = {}  # field name -> bytes, since the last init
+
+
+def field(name: str, dtype, shape, n: int | None = None):
+    """Allocate a (vector) field and account for its bytes, so a run can show what it allocated."""
+    f = ti.field(dtype, shape) if n is None else ti.Vector.field(n, dtype, shape)
+    count = 1
+    for s in (shape if isinstance(shape, tuple) else (shape,)):
+        count *= s
+    allocated[name] = allocated.get(name, 0) + count * (n or 1) * _size(dtype)
+    return f
+
+
+def _size(dtype) -> int:
+    return {ti.f64: 8, ti.i64: 8, ti.f32: 4, ti.i32: 4, ti.u32: 4, ti.u8: 1}[dtype]
+
+
+warnings.filterwarnings("ignore", category=DeprecationWarning, module="taichi")
