@@ -5,14 +5,10 @@ value times a float literal is computed in f64, so "f32" would silently be f64 a
 """
 from __future__ import annotations
 
-import os
 import sys
 import warnings
 
-os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")  # no network look-up at start-up
-os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
-
-import taichi as ti  # noqa: E402
+import taichi as ti
 
 ARCHES = ("cpu", "cuda")
 _current: tuple | None = None
