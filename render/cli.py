@@ -6,6 +6,7 @@ import importlib
 import importlib.util
 import os
 import signal
+import tempfile
 import sys
 from pathlib import Path
 
@@ -70,8 +71,12 @@ def check_writable(path: Path, what: str = "--out"):
     probe = path
     while not probe.exists():
         probe = probe.parent
-    if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
-        raise SceneError(f"{what} {path}: not a writable directory ({probe})")
+    try:
+        if not probe.is_dir():
+            raise NotADirectoryError(probe)
+        tempfile.TemporaryFile(dir=probe).close()  # os.access says yes to root even where writing fails
+    except OSError:
+        raise SceneError(f"{what} {path}: not a writable directory ({probe})") from None
 
 
 def progress_wanted(args) -> bool:
@@ -146,6 +151,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("pendulum: interrupted; no partial output was left", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. `pendulum presets | head`
+        sys.stdout = open(os.devnull, "w")
+        return 0
     except Terminated:
         print("pendulum: terminated; no partial output was left", file=sys.stderr)
         return 143

@@ -38,14 +38,17 @@ class SceneError(ValueError):
     """Bad input: one line, naming the file and the key."""
 
 
+REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+
+
 # The schema: section -> key -> default. A default of None means "derived" (see _derive).
 SCHEMA: dict[str, object] = {
     "name": "scene",
     "description": "",
-    "system": "rigid",
+    "system": REQUIRED,
     "effects": None,
     "pendulums": {
-        "count": 1, "layout": "fan",
+        "count": REQUIRED, "layout": "fan",
         "theta1": math.pi, "theta2": math.pi, "omega1": 0.0, "omega2": 0.0, "spread": 1e-4,
         "lengths": [1.0, 1.0], "masses": [1.0, 1.0], "gravity": 9.8, "stiffness": 2e3, "damping": 0.0,
     },
@@ -167,12 +170,12 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
     except (OSError, UnicodeDecodeError) as e:
         raise SceneError(f"{src}: cannot read: {e}") from None
     raw.setdefault("name", path.stem)
-    if quality is not None:
+    if quality is not None and raw.get("system") in SYSTEMS:  # otherwise validation names the bad system
         from .quality import integrator_for
         raw.setdefault("integrator", {})
         if not isinstance(raw["integrator"], dict):
             raise SceneError(f"{src}: integrator: must be a table")
-        raw["integrator"].update(integrator_for(quality, raw.get("system", "rigid"), src))
+        raw["integrator"].update(integrator_for(quality, raw.get("system"), src))
     for item in overrides:
         _apply_override(raw, item, src)
     return from_dict(raw, src)
@@ -244,8 +247,11 @@ class _Validator:
             else:
                 out[k] = val
         for k, default in schema.items():
-            if k not in out:
-                out[k] = self.merge({}, default, prefix + k + ".") if isinstance(default, dict) else default
+            if k in out:
+                continue
+            if default is REQUIRED:
+                self.fail(prefix + k, "missing (this key is required)")
+            out[k] = self.merge({}, default, prefix + k + ".") if isinstance(default, dict) else default
         return out
 
     # typed getters ------------------------------------------------
