@@ -122,7 +122,7 @@ class Scene:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
-        return d
+        return json.loads(json.dumps(d))  # tuples to lists: the same dict metadata.json reads back as
 
     def hash(self) -> str:
         blob = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))

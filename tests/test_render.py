@@ -1,0 +1,138 @@
+"""End to end: every shipped preset, shortened, rendered and decoded back; `simulate`; the CLI entry points."""
+import json
+import math
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from conftest import ROOT, run_cli
+from render import pipeline
+from render.scene import list_presets, load
+
+PRESETS = [p.stem for p in list_presets()]
+W, H, FPS, SECONDS = 320, 180, 30, 0.5
+MIN_PSNR_MP4 = 30.0  # dB, decoded first frame vs the raw frame (H.264 crf 20, yuv420p chroma subsampling)
+MIN_PSNR_GIF = 18.0  # dB, after downscaling the raw frame to the GIF's size (256-colour palette, dithered)
+
+
+def short(name, **extra):
+    sets = [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", f"video.duration={SECONDS}"]
+    scene = load(name, sets)
+    if scene.pendulums.layout == "grid":  # one pendulum per pixel
+        sets.append(f"pendulums.count={W * H}")
+    return load(name, sets + [f"{k}={v}" for k, v in extra.items()])
+
+
+def psnr(a, b):
+    mse = np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2)
+    return 99.0 if mse == 0 else 10 * np.log10(255.0 ** 2 / mse)
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """Render each preset once (short, small); keep the raw first frame for comparison."""
+    out = tmp_path_factory.mktemp("render")
+    results = {}
+    for name in PRESETS:
+        raw = {}
+        meta = pipeline.render(short(name), out, frame_hook=lambda f, fr: raw.setdefault(f, fr.copy()))
+        results[name] = (out / name, meta, raw[0])
+    return results
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_mp4_decodes_to_every_frame(rendered, name):
+    d, meta, first = rendered[name]
+    frames = iio.imread(d / f"{name}.mp4")
+    info = iio.immeta(d / f"{name}.mp4")
+    assert frames.shape == (round(FPS * SECONDS), H, W, 3)
+    assert info["fps"] == FPS and info["codec"] == "h264" and info["pix_fmt"].startswith("yuv420p")
+    assert psnr(frames[0], first) >= MIN_PSNR_MP4
+    assert meta["outputs"][f"{name}.mp4"] == (d / f"{name}.mp4").stat().st_size
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_gif_decodes_downscaled_at_its_own_rate(rendered, name):
+    from PIL import Image
+
+    d, meta, first = rendered[name]
+    scene = short(name)
+    gif = iio.imread(d / f"{name}.gif")
+    gif_fps = min(scene.video.gif_fps, FPS)
+    gw = scene.video.gif_width
+    assert gif.shape[0] == math.ceil(gif_fps * round(FPS * SECONDS) / FPS - 1e-9)  # ffmpeg's fps filter
+    assert gif.shape[1:3] == (round(H * gw / W / 2) * 2, gw)
+    with Image.open(d / f"{name}.gif") as im:
+        assert im.info["duration"] == 1000 // gif_fps and im.info.get("loop") == 0
+    small = np.asarray(Image.fromarray(first).resize((gif.shape[2], gif.shape[1]), Image.LANCZOS))
+    assert psnr(gif[0][..., :3], small) >= MIN_PSNR_GIF
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_metadata_has_the_contract_fields(rendered, name):
+    d, meta, _ = rendered[name]
+    on_disk = json.loads((d / "metadata.json").read_text())
+    assert on_disk == meta
+    for key in ("preset", "preset_hash", "versions", "arch", "frames", "fps", "width", "height", "duration",
+                "integrator", "effects", "kernels", "energy", "timings_s", "outputs", "field_bytes"):
+        assert key in meta, key
+    assert set(meta["versions"]) >= {"package", "taichi", "numpy", "ffmpeg"}
+    assert set(meta["integrator"]) >= {"method", "dt", "substeps", "precision"}
+    assert set(meta["timings_s"]) >= {"simulate", "draw", "encode", "total"}
+    assert meta["frames"] == round(FPS * SECONDS) and meta["arch"] == "cpu"
+    assert meta["preset"]["name"] == name and meta["preset_hash"] == short(name).hash()
+    assert meta["integrator"]["substeps"] * meta["integrator"]["dt"] == pytest.approx(1 / FPS)
+    if "energy" in meta["effects"]:
+        assert 0 <= meta["energy"]["max_rel_drift"] < 1e-3
+    assert not list(d.glob(".*")), "temporary files left behind"
+
+
+def test_simulate_writes_the_trajectory_format(tmp_path):
+    out = tmp_path / "traj.npz"
+    r = run_cli("simulate", "elastic_fan", "--out", out, "--set", "video.duration=0.5", "--set", "video.fps=20")
+    assert r.returncode == 0, r.stderr
+    z = np.load(out)
+    assert set(z.files) == {"t", "pos", "vel", "energy"}
+    assert z["t"].shape == (10,) and z["t"][0] == 0 and z["t"][-1] == pytest.approx(9 / 20)
+    assert z["pos"].shape == (10, 10, 2, 2) and z["vel"].shape == (10, 10, 2, 2) and z["energy"].shape == (10, 10)
+    # row 0 is the initial state: pendulum 0 at rest lengths along theta1, theta2
+    p = load("elastic_fan").pendulums
+    x1 = p.lengths[0] * np.array([np.sin(p.theta1), -np.cos(p.theta1)])
+    np.testing.assert_allclose(z["pos"][0, 0, 0], x1, atol=1e-12)
+    np.testing.assert_allclose(z["energy"], np.broadcast_to(z["energy"][0], (10, 10)), rtol=1e-4)
+
+
+def test_simulate_rigid_and_python_dash_m(tmp_path):
+    out = tmp_path / "sub" / "classic.npz"
+    r = run_cli("simulate", "classic", "--out", out, "--set", "video.duration=0.2", "--set", "video.fps=10")
+    assert r.returncode == 0, r.stderr
+    z = np.load(out)
+    assert set(z.files) == {"t", "theta", "omega", "energy"} and z["theta"].shape == (2, 1, 2)
+    np.testing.assert_allclose(z["theta"][0, 0], [np.radians(120), np.radians(-10)])
+
+
+def test_presets_lists_every_file_and_help_explains():
+    r = run_cli("presets")
+    assert r.returncode == 0
+    assert [line.split()[0] for line in r.stdout.splitlines()] == PRESETS
+    assert {"rigid_chaos", "elastic_fan", "classic"} <= set(PRESETS)
+    h = run_cli("render", "--help")
+    assert h.returncode == 0 and "--set" in h.stdout and "--quality" in h.stdout and "--arch" in h.stdout
+
+
+def test_seed_presets_match_the_brief():
+    rigid, elastic = load("rigid_chaos"), load("elastic_fan")
+    assert (rigid.system, rigid.pendulums.count, rigid.pendulums.spread) == ("rigid", 100, 1e-4)
+    assert (elastic.system, elastic.pendulums.count) == ("elastic", 10)
+    assert elastic.pendulums.spread == pytest.approx(np.pi / 20)
+    assert "trails" in rigid.effects and "springs" in elastic.effects
+
+
+def test_cuda_request_falls_back_to_cpu_with_one_warning(tmp_path):
+    r = run_cli("render", "classic", "--arch", "cuda", "--out", tmp_path, "--set", "video.duration=0.1",
+                "--set", "video.width=64", "--set", "video.height=48")
+    assert r.returncode == 0, r.stderr
+    meta = json.loads((tmp_path / "classic" / "metadata.json").read_text())
+    if meta["arch"] == "cpu":  # no GPU here (CI): exactly one clear warning
+        assert r.stderr.count("warning: --arch cuda") == 1
