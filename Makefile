@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 export TI_SKIP_VERSION_CHECK := ON
 
-.PHONY: demo test presets accuracy bench batch clean
+.PHONY: demo test goldens presets accuracy bench batch clean
 
 $(BIN)/pendulum: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,6 +17,10 @@ demo: $(BIN)/pendulum
 
 test: $(BIN)/pendulum
 	$(BIN)/python -m pytest
+
+# After a deliberate visual change: rewrite tests/golden/ from the current renderer, then review and commit.
+goldens: $(BIN)/pendulum
+	$(BIN)/python -m pytest tests/test_golden.py --update-goldens -q
 
 presets: $(BIN)/pendulum
 	$(BIN)/pendulum presets
