@@ -1,0 +1,83 @@
+"""Cost per frame of each effect, toggled one at a time on the same scene (simulate + draw, no encoding).
+
+    .venv/bin/python benchmarks/effects.py [--frames 240] [--out out/bench/effects.md]
+
+Each row adds one effect to the row above and reports ms per frame at the preset's 1280x720, 60 fps, so the
+difference between rows is what that effect costs. Times are medians of per-frame times after a warm-up
+that pays for kernel compilation.
+"""
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from render import pipeline, runtime  # noqa: E402
+from render.canvas import Canvas  # noqa: E402
+from render.scene import load  # noqa: E402
+
+LADDERS = {
+    "rigid_chaos": [["energy"], ["bobs"], ["bobs", "rods"], ["bobs", "rods", "trails"],
+                    ["bobs", "rods", "trails", "energy"], ["bobs", "rods", "trails", "energy", "damping"]],
+    "elastic_fan": [["energy"], ["bobs"], ["bobs", "springs"], ["bobs", "springs", "trails"],
+                    ["bobs", "springs", "trails", "energy"]],
+}
+WARMUP = 10
+
+
+def measure(preset: str, effects: list[str], frames: int) -> dict:
+    sets = [f"effects={effects!r}".replace("'", '"'), f"video.duration={(frames + WARMUP) / 60}"]
+    if "damping" in effects:
+        sets.append("pendulums.damping=0.1")
+    scene = load(preset, sets)
+    runtime.init("cpu", scene.integrator.precision)
+    sim = pipeline.make_system(scene)
+    drawn = any(e in scene.effects for e in ("bobs", "rods", "springs", "trails"))
+    canvas = Canvas(scene, sim) if drawn else None
+    sim_ms, draw_ms = [], []
+    timings = {"simulate": 0.0}
+    for f in pipeline.frames(scene, sim, timings):
+        sim_ms.append(timings["simulate"] * 1e3)
+        timings["simulate"] = 0.0
+        t = time.perf_counter()
+        if canvas:
+            canvas.draw()
+        draw_ms.append((time.perf_counter() - t) * 1e3)
+    sim_ms, draw_ms = sim_ms[WARMUP:], draw_ms[WARMUP:]
+    return {"preset": preset, "effects": effects, "sim": statistics.median(sim_ms),
+            "draw": statistics.median(draw_ms), "fields": sum(runtime.allocated.values()),
+            "kernels": len(runtime.launched)}
+
+
+def table(rows: list[dict]) -> str:
+    out = ["| scene | effects | simulate ms/frame | draw ms/frame | total ms/frame | added by the last effect | "
+           "field MB | kernels |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    prev = None
+    for r in rows:
+        total = r["sim"] + r["draw"]
+        delta = "" if prev is None or prev["preset"] != r["preset"] else f"{total - prev['sim'] - prev['draw']:+.2f}"
+        effects = ", ".join(r["effects"]) if r["effects"] != ["energy"] else "energy only (no drawing)"
+        out.append(f"| {r['preset']} | {effects} | {r['sim']:.2f} | {r['draw']:.2f} | {total:.2f} | {delta} | "
+                   f"{r['fields'] / 1e6:.1f} | {r['kernels']} |")
+        prev = r
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--frames", type=int, default=240, help="timed frames per row (default 240)")
+    ap.add_argument("--out", type=Path, help="also write the markdown table here")
+    args = ap.parse_args(argv)
+    rows = [measure(p, e, args.frames) for p, ladder in LADDERS.items() for e in ladder]
+    text = table(rows)
+    print(text)
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(text + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
