@@ -5,6 +5,8 @@ value times a float literal is computed in f64, so "f32" would silently be f64 a
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import sys
 import warnings
 
@@ -27,15 +29,13 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) 
               random_seed=0, offline_cache=True)
     if threads:
         kw["cpu_max_num_threads"] = threads
-    used = "cpu"
-    if arch == "cuda":
-        # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
-        ti.init(arch=ti.cuda, **kw)
-        used = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
-        if used == "cpu":
-            print("warning: --arch cuda: no CUDA device found, running on the CPU", file=sys.stderr)
-    else:
-        ti.init(arch=ti.cpu, **kw)
+    # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
+    # ti.init prints "[Taichi] Starting on arch=..." to stdout unconditionally; stdout is for results.
+    with contextlib.redirect_stdout(io.StringIO()):
+        ti.init(arch=ti.cuda if arch == "cuda" else ti.cpu, **kw)
+    used = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
+    if arch == "cuda" and used == "cpu":
+        print("warning: --arch cuda: no CUDA device found, running on the CPU", file=sys.stderr)
     _current = (want, used)
     launched.clear()
     allocated.clear()
