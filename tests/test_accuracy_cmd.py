@@ -1,0 +1,56 @@
+"""`pendulum accuracy --quick` end to end: files, exact CSV columns, every method, valid PNGs, sane orders."""
+import csv
+
+import imageio.v3 as iio
+import numpy as np
+
+from conftest import run_cli
+from render.accuracy import COLUMNS
+from render.scene import METHODS
+
+THEORY = {"symplectic_euler": 1, "verlet": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
+PNGS = ("work_precision_rigid.png", "work_precision_elastic.png", "energy_drift_rigid.png",
+        "energy_drift_elastic.png", "divergence.png")
+
+
+def test_accuracy_quick_writes_tables_and_charts(tmp_path):
+    out = tmp_path / "acc"
+    r = run_cli("accuracy", "--quick", "--out", out, timeout=240)
+    assert r.returncode == 0, r.stderr
+    assert "accuracy [" in r.stderr  # progress on stderr
+    assert sorted(p.name for p in out.iterdir()) == sorted([*PNGS, "accuracy.csv", "accuracy.md"])  # no temp files
+
+    with open(out / "accuracy.csv", newline="") as f:
+        reader = csv.DictReader(f)
+        assert tuple(reader.fieldnames) == COLUMNS
+        assert COLUMNS == ("system", "method", "precision", "dt", "traj_error", "energy_drift", "ns_per_step",
+                           "order")
+        rows = list(reader)
+    seen = {(r["system"], r["method"], r["precision"]) for r in rows}
+    assert seen == {(s, m, p) for s in METHODS for m in METHODS[s] for p in ("f32", "f64")}
+    for r in rows:
+        assert float(r["traj_error"]) > 0 and float(r["ns_per_step"]) > 0 and float(r["energy_drift"]) >= 0
+        if r["precision"] == "f64" and r["order"]:  # quick rungs are in the asymptotic regime in f64
+            assert abs(float(r["order"]) - THEORY[r["method"]]) <= 0.3, r
+    assert sum(1 for r in rows if r["order"]) == len(rows) // 2  # one order per pair of rungs
+
+    md = (out / "accuracy.md").read_text()
+    assert "| " + " | ".join(COLUMNS) + " |" in md
+    table = [ln for ln in md.splitlines() if ln.startswith(("| rigid |", "| elastic |")) and ln.count("|") == 9]
+    assert len(table) == len(rows)
+    assert "## Energy over" in md
+
+    for name in PNGS:
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        img = iio.imread(out / name)
+        assert img.ndim == 3 and img.shape[0] > 300 and img.shape[1] > 400
+        assert np.asarray(img[..., :3], dtype=float).std() > 5  # something was drawn
+
+
+def test_accuracy_bad_input_exits_2(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    r = run_cli("accuracy", "--out", blocker / "sub")
+    assert r.returncode == 2 and "--out" in r.stderr and "Traceback" not in r.stderr
+    r = run_cli("accuracy", "--system", "chaotic")
+    assert r.returncode == 2
