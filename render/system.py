@@ -64,7 +64,7 @@ class System(runtime.Launcher):
         self.m1, self.m2 = p.masses
         self.l1, self.l2 = p.lengths
         self.h, self.substeps = timestep(scene, self.omega_max())
-        self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solve, in state units
+        self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
         real = runtime.real()
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
@@ -123,6 +123,8 @@ class System(runtime.Launcher):
 
     @ti.func
     def symplectic_euler(self, q, v, h):
+        """The seed's v += a·h; x += v·h. Symplectic for the separable elastic system only: on the rigid
+        system (θ, ω) are not canonical, so its energy error grows slowly (see README, Accuracy vs. time)."""
         v += h * self.force(q, v)
         return q + h * v, v
 
@@ -142,19 +144,6 @@ class System(runtime.Launcher):
         q4, v4 = q + h * v3, v + h * a3
         a4 = self.force(q4, v4)
         return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-
-    @ti.func
-    def implicit_midpoint(self, q, v, h):
-        """y1 = y0 + h·f((y0+y1)/2), solved by fixed-point iteration to self.tol (at most 100 sweeps)."""
-        q1, v1 = q + h * v, v + h * self.force(q, v)
-        for _ in range(100):
-            qm, vm = 0.5 * (q + q1), 0.5 * (v + v1)
-            qn, vn = q + h * vm, v + h * self.force(qm, vm)
-            err = ti.max((qn - q1).norm_sqr(), (vn - v1).norm_sqr() * h * h)
-            q1, v1 = qn, vn
-            if err <= self.tol * self.tol:
-                break
-        return q1, v1
 
     @ti.func
     def advance_one(self, i: ti.i32, substeps: ti.i32):
