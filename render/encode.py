@@ -1,9 +1,12 @@
 """Stream raw frames into the ffmpeg bundled with imageio-ffmpeg: MP4 and GIF from one pass.
 
 Each format has its own ffmpeg process writing to a hidden temporary file beside the final one; close()
-renames them into place only when every process succeeded, abort() removes them. Frames go through a small
-bounded queue to a writer thread, so drawing the next frame overlaps with encoding this one and memory stays
-flat.
+renames them into place only when every process succeeded, abort() removes them.
+
+Pipelining: each ffmpeg process has its own writer thread fed from its own small bounded queue, so
+simulating and drawing the next frames overlaps with encoding the previous ones, a slow GIF never stalls the
+MP4 (or the other way round), and memory stays flat (the queues share the frame arrays, they do not copy
+them). The pipes are enlarged so a writer hands over a frame in a few system calls.
 """
 from __future__ import annotations
 
@@ -18,7 +21,14 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 
-QUEUE_FRAMES = 8
+try:
+    import fcntl
+except ImportError:  # not POSIX: default pipe sizes
+    fcntl = None
+
+QUEUE_FRAMES = 6  # per ffmpeg process: at most ~14 distinct 720p frames (2.8 MB each) are ever waiting
+PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe (/proc/sys/fs/pipe-max-size)
+F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call fails harmlessly
 
 
 def mp4_args(video) -> list[str]:
@@ -28,7 +38,8 @@ def mp4_args(video) -> list[str]:
 
 def gif_args(video) -> list[str]:
     fps = min(video.gif_fps, video.fps)
-    graph = (f"fps={fps},scale={video.gif_width}:-2:flags=lanczos,split[a][b];"
+    # eof_action=pass: the last input frame always counts, so a one-frame video still makes a GIF
+    graph = (f"fps={fps}:eof_action=pass,scale={video.gif_width}:-2:flags=lanczos,split[a][b];"
              f"[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer:bayer_scale=3")
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
 
@@ -40,13 +51,44 @@ class EncodeError(RuntimeError):
     pass
 
 
+class _Target:
+    """One ffmpeg process, the thread that feeds it, and where its output goes."""
+
+    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log):
+        self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
+        self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
+        self.error: BaseException | None = None
+        self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
+        try:
+            fcntl.fcntl(proc.stdin.fileno(), F_SETPIPE_SZ, PIPE_BYTES)
+        except (OSError, AttributeError):
+            pass  # a smaller pipe only means more system calls
+        self.thread = threading.Thread(target=self._pump, name=f"encode-{final.suffix[1:]}", daemon=True)
+        self.thread.start()
+
+    def _pump(self):
+        fd = self.proc.stdin.fileno()
+        while True:
+            frame = self.queue.get()
+            if frame is None:
+                return
+            if self.error is not None:
+                continue  # keep draining so the producer never blocks on a dead encoder
+            t = time.perf_counter()
+            try:
+                view = memoryview(np.ascontiguousarray(frame)).cast("B")
+                while view:  # os.write releases the GIL while it blocks on the pipe
+                    view = view[os.write(fd, view):]
+            except BaseException as e:  # a dead ffmpeg: report it from the main thread
+                self.error = e
+            self.busy_s += time.perf_counter() - t
+
+
 class Encoder:
     """Writes `frames` to out_dir/NAME.<fmt> for each format; use as a context manager or call close/abort."""
 
     def __init__(self, out_dir: Path, name: str, video, formats=None):
-        self.targets: list[tuple[Path, Path, subprocess.Popen, object]] = []
-        self.busy_s = 0.0
-        self.error: BaseException | None = None
+        self.targets: list[_Target] = []
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         try:
             for fmt in formats or video.formats:
@@ -57,82 +99,89 @@ class Encoder:
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
                        "-s", f"{video.width}x{video.height}", "-r", str(video.fps), "-i", "-", "-an",
                        *ARGS[fmt](video), tmp]
-                proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
-                                        start_new_session=True)  # Ctrl-C reaches us, and we clean up
-                self.targets.append((final, Path(tmp), proc, log))
+                try:
+                    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
+                                            start_new_session=True)  # Ctrl-C reaches us, and we clean up
+                except BaseException:
+                    Path(tmp).unlink(missing_ok=True)
+                    log.close()
+                    raise
+                self.targets.append(_Target(final, Path(tmp), proc, log))
         except BaseException:
             self.abort()
             raise
-        self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
-        self.thread = threading.Thread(target=self._pump, daemon=True)
-        self.thread.start()
 
-    def _pump(self):
-        while True:
-            frame = self.queue.get()
-            if frame is None:
-                return
-            t = time.perf_counter()
-            try:
-                if self.error is None:
-                    buf = memoryview(np.ascontiguousarray(frame)).cast("B")
-                    for _, _, proc, _ in self.targets:
-                        proc.stdin.write(buf)
-            except BaseException as e:  # a dead ffmpeg: report it from the main thread
-                self.error = e
-            self.busy_s += time.perf_counter() - t
+    @property
+    def busy_s(self) -> float:
+        """Seconds the busiest writer spent feeding ffmpeg."""
+        return max((t.busy_s for t in self.targets), default=0.0)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, tb):
+        if kind is None:
+            self.close()
+        else:
+            self.abort()
 
     def write(self, frame: np.ndarray):
-        if self.error is not None:
-            raise EncodeError(f"ffmpeg stopped: {self._logs() or self.error}")
-        self.queue.put(frame)
+        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind.
+
+        The frame is shared, not copied: do not modify it after writing it.
+        """
+        for t in self.targets:
+            if t.error is not None:
+                raise EncodeError(f"ffmpeg stopped: {self._logs() or t.error}")
+        for t in self.targets:
+            t.queue.put(frame)
 
     def close(self) -> dict[str, int]:
         """Finish encoding and rename into place; returns file name -> bytes."""
-        t = time.perf_counter()
-        self.queue.put(None)
-        self.thread.join()
-        codes = []
-        for _, _, proc, _ in self.targets:
+        for t in self.targets:
+            t.queue.put(None)
+        for t in self.targets:
+            t.thread.join()
             try:
-                proc.stdin.close()
+                t.proc.stdin.close()  # EOF: ffmpeg flushes (the GIF's palette needs every frame first)
             except OSError:
                 pass
-            codes.append(proc.wait())
-        self.busy_s += time.perf_counter() - t
-        if self.error is not None or any(codes):
-            msg = self._logs() or str(self.error)
+        codes = [t.proc.wait() for t in self.targets]
+        errors = [t.error for t in self.targets if t.error is not None]
+        if errors or any(codes):
+            msg = self._logs() or str(errors[0] if errors else f"exit status {max(codes)}")
             self.abort()
             raise EncodeError(f"ffmpeg failed: {msg}")
         sizes = {}
-        for final, tmp, _, log in self.targets:
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, final)
-            sizes[final.name] = final.stat().st_size
-            log.close()
+        for t in self.targets:
+            os.chmod(t.tmp, 0o644)
+            os.replace(t.tmp, t.final)
+            sizes[t.final.name] = t.final.stat().st_size
+            t.log.close()
         self.targets = []
         return sizes
 
     def abort(self):
         """Stop ffmpeg and remove the temporary files; safe to call more than once."""
-        if hasattr(self, "queue"):
-            self.error = self.error or EncodeError("aborted")
+        for t in self.targets:
+            t.error = t.error or EncodeError("aborted")
+            t.proc.kill()  # unblocks a writer stuck on a full pipe: its write fails and it drains the queue
+        for t in self.targets:
+            t.proc.wait()
             try:
-                self.queue.put_nowait(None)
+                t.queue.put(None, timeout=5)  # the writer drains, so there is room soon
             except queue.Full:
                 pass
-        for _, tmp, proc, log in self.targets:
-            proc.kill()
-            proc.wait()
-            tmp.unlink(missing_ok=True)
-            log.close()
+            t.thread.join(timeout=5)
+            t.tmp.unlink(missing_ok=True)
+            t.log.close()
         self.targets = []
 
     def _logs(self) -> str:
         out = []
-        for _, _, _, log in self.targets:
-            log.seek(0)
-            out.append(log.read().decode(errors="replace").strip())
+        for t in self.targets:
+            t.log.seek(0)
+            out.append(t.log.read().decode(errors="replace").strip())
         return " | ".join(x.splitlines()[-1] for x in out if x)
 
 
