@@ -1,0 +1,343 @@
+"""`pendulum bench`: how close a render comes to the encoder's floor, simulation vs numpy, and the fractal.
+
+Every phase runs in its own subprocess (a fresh Taichi runtime) while this process samples the resident memory
+of that process tree (ffmpeg included), so all figures of one report come from one run. Precision is fixed
+per Taichi init, so the simulation phase runs f32, then f64. Method and findings: benchmarks/README.md.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+CHAOS, FRACTAL = "rigid_chaos", "fractal"
+SYSTEMS = {"rigid": ("rigid_chaos", '["rods"]'), "elastic": ("elastic_fan", '["springs"]')}  # no energy
+FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "fractal_s": None, "min_s": 0.3}
+QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "fractal_s": 0.5, "min_s": 0.1}
+TARGETS = [("end_to_end_over_encode_floor", "<=", 1.3), ("sim_speedup_vs_numpy_1e5", ">=", 10.0),
+           ("fractal_fps", ">=", 5.0), ("fractal_peak_mem_mb", "<", 2048.0)]  # issue 8
+
+
+def add_parser(sub):
+    p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal",
+                       description="Measure simulation throughput (Taichi vs numpy), drawing and encoding fps, "
+                                   "an end-to-end render against the encode-only floor, and the fractal preset; "
+                                   "write OUT/report.md and OUT/report.json.")
+    p.add_argument("--quick", action="store_true", help="small N ladder and short videos (about 30 s)")
+    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
+    p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
+    p.add_argument("--phase", help=argparse.SUPPRESS)  # internal: run one phase in this process
+    p.add_argument("--result", type=Path, help=argparse.SUPPRESS)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    cfg = QUICK if args.quick else FULL
+    if args.phase:
+        result = PHASES[args.phase](cfg, args.arch, args.out)
+        args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
+        return 0
+    from .cli import check_writable
+    from .pipeline import write_atomic
+
+    check_writable(args.out)
+    t0, res = time.perf_counter(), {}
+    with tempfile.TemporaryDirectory(prefix="pendulum-bench-") as tmp:
+        for name in PHASES:
+            print(f"bench: {name} ...", file=sys.stderr, flush=True)
+            res[name] = run_phase(name, args, Path(tmp))
+    report = summarise(res, args.quick, time.perf_counter() - t0)
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
+    write_atomic(args.out / "report.md", markdown(report).encode())
+    for key, t in report["targets"].items():
+        print(f"{key} = {t['value']:.3g} (target {t['goal']}): {'met' if t['met'] else 'MISSED'}")
+    print(f"-> {args.out}/report.md ({report['wall_s']:.0f} s)")
+    return 0
+
+
+# ---------------------------------------------------------------- running phases, measuring memory
+
+def run_phase(name: str, args, tmp: Path) -> dict:
+    """One phase in a subprocess; its result plus the peak resident memory of its process tree."""
+    result = tmp / f"{name}.json"
+    cmd = [sys.executable, "-m", "render", "bench", "--phase", name, "--result", str(result), "--out", str(tmp),
+           "--arch", args.arch] + (["--quick"] if args.quick else [])
+    proc, peak = subprocess.Popen(cmd, stdout=subprocess.DEVNULL), 0
+    try:  # the sum over the tree at one instant, which ru_maxrss (the largest single process) cannot give
+        while proc.poll() is None:
+            peak = max(peak, tree_rss(proc.pid))
+            time.sleep(0.05)
+    finally:
+        if proc.poll() is None:  # interrupted: do not leave the phase running
+            proc.terminate()
+            proc.wait()
+    code = proc.returncode
+    if code != 0:
+        from .system import SimulationError  # the CLI's "failure while running": exit 1, one line
+        raise SimulationError(f"bench phase {name!r} failed (exit {code}); see the messages above")
+    out = json.loads(result.read_text())
+    out["peak_mem_mb"] = max(peak / 2**20, out.pop("maxrss_mb"))  # /proc may be missing, or miss a spike
+    return out
+
+
+def tree_rss(pid: int) -> int:
+    """Resident bytes of a process and all its descendants (Linux /proc; 0 elsewhere)."""
+    total, todo, page = 0, [pid], os.sysconf("SC_PAGE_SIZE")
+    while todo:
+        p = todo.pop()
+        try:
+            with open(f"/proc/{p}/statm") as f:
+                total += int(f.read().split()[1]) * page
+            for tid in os.listdir(f"/proc/{p}/task"):
+                with open(f"/proc/{p}/task/{tid}/children") as f:
+                    todo += [int(c) for c in f.read().split()]
+        except (OSError, ValueError):
+            pass
+    return total
+
+
+def maxrss_mb() -> float:  # the largest single process: this phase, or one of its ffmpeg children
+    import resource
+    return max(resource.getrusage(w).ru_maxrss for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)) / 1024
+
+
+# ---------------------------------------------------------------- phases
+
+def phase_sim(cfg, arch, tmp) -> dict:
+    """Pendulum-substeps per second of the Taichi kernel and of the numpy baseline: same RK4, same state."""
+    import taichi as ti
+    from . import pipeline, runtime
+    from .scene import load
+
+    rows = []
+    for prec in ("f32", "f64"):
+        runtime.init(arch, prec)
+        for system, (preset, effects) in SYSTEMS.items():
+            for n in cfg["ladder"]:
+                scene = load(preset, [f"pendulums.count={n}", 'integrator.method="rk4"', "integrator.dt=1e-3",
+                                      f'integrator.precision="{prec}"', f"effects={effects}"])
+                sim = pipeline.make_system(scene)
+                kern, q0, v0 = f"{sim.NAME}_advance", sim.q.to_numpy().T.copy(), sim.v.to_numpy().T.copy()
+                if n == cfg["ladder"][0]:  # first check that both integrate the same thing
+                    base = Baseline(scene, q0, v0, sim.h)
+                    sim.launch(kern, 100)
+                    for _ in range(100):
+                        base.step()
+                    agree = float(np.abs(sim.q.to_numpy().T - base.q).max())
+                base = Baseline(scene, q0, v0, sim.h)
+                taichi = rate(lambda k: (sim.launch(kern, k), ti.sync()), n, cfg["min_s"])
+                numpy = rate(lambda k: [base.step() for _ in range(k)], n, cfg["min_s"])
+                rows.append({"system": system, "precision": prec, "n": n, "taichi": taichi, "numpy": numpy,
+                             "speedup": taichi / numpy, "agree": agree})
+    return {"rows": rows}
+
+
+def rate(step, n: int, min_s: float) -> float:
+    """Pendulum-substeps per second; step(k) advances all n pendulums k substeps. Best of 3 runs >= min_s."""
+    step(1)  # compiles
+    k, runs = max(1, int(1e4 / n)), []
+    while len(runs) < 3:
+        t = time.perf_counter()
+        step(k)
+        dt = time.perf_counter() - t
+        if dt >= min_s:
+            runs.append(n * k / dt)
+        else:
+            k = max(k + 1, int(k * min(20.0, 1.3 * min_s / max(dt, 1e-6))))
+    return max(runs)
+
+
+class Baseline:
+    """The benchmark's numpy-vectorised baseline: the RK4 and forces of render/rigid.py and elastic.py."""
+
+    def __init__(self, scene, q, v, h: float):
+        self.q, self.v, self.h, self.p = q, v, h, scene.pendulums
+        (self.m1, self.m2), (self.l1, self.l2) = self.p.masses, self.p.lengths
+        self.accel = self.rigid if scene.system == "rigid" else self.elastic
+
+    def rigid(self, q, v):
+        m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.p.gravity
+        d = q[0] - q[1]
+        sd, cd, den = np.sin(d), np.cos(d), 2 * m1 + m2 - m2 * np.cos(2 * d)
+        a1 = (-g * (2 * m1 + m2) * np.sin(q[0]) - m2 * g * np.sin(q[0] - 2 * q[1])
+              - 2 * sd * m2 * (v[1] * v[1] * l2 + v[0] * v[0] * l1 * cd)) / (l1 * den)
+        a2 = 2 * sd * (v[0] * v[0] * l1 * (m1 + m2) + g * (m1 + m2) * np.cos(q[0]) + v[1] * v[1] * l2 * m2 * cd)
+        return np.stack([a1, a2 / (l2 * den)])
+
+    def elastic(self, q, v):
+        k1, k2, d2 = self.p.stiffness / self.l1, self.p.stiffness / self.l2, q[2:] - q[:2]
+        r1, r2 = np.hypot(q[0], q[1]), np.hypot(d2[0], d2[1])
+        f1 = -k1 * (r1 - self.l1) / np.maximum(r1, 1e-12) * q[:2]
+        f2 = -k2 * (r2 - self.l2) / np.maximum(r2, 1e-12) * d2
+        a = np.concatenate([(f1 - f2) / self.m1, f2 / self.m2])
+        a[1::2] -= self.p.gravity
+        return a
+
+    def step(self):
+        q, v, h, f = self.q, self.v, self.h, self.accel
+        a1 = f(q, v)
+        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
+        a2 = f(q2, v2)
+        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
+        a3 = f(q3, v3)
+        q4, v4 = q + h * v3, v + h * a3
+        a4 = f(q4, v4)
+        self.q, self.v = q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+
+
+def chaos_scene(cfg):
+    from .scene import load
+    return load(CHAOS, [f"video.duration={cfg['chaos_s']}"])
+
+
+def phase_encode(cfg, arch, tmp) -> dict:
+    """Draw rigid_chaos's frames into a raw file (timing simulate and draw), then time only the encoding of
+    those frames (memory-mapped) through the same Encoder: the floor an end-to-end render cannot beat."""
+    from . import pipeline, runtime
+    from .canvas import Canvas
+    from .encode import Encoder
+
+    scene = chaos_scene(cfg)
+    runtime.init(arch, scene.integrator.precision)
+    sim = pipeline.make_system(scene)
+    canvas, raw, timings, draw = Canvas(scene, sim), tmp / "frames.raw", {"simulate": 0.0}, 0.0
+    with open(raw, "wb") as fh:
+        for f in pipeline.frames(scene, sim, timings):
+            if f == 2:  # frames 0 and 1 instantiate the kernels; time the steady state
+                timings["simulate"], draw = 0.0, 0.0
+            t = time.perf_counter()
+            frame = canvas.draw()
+            draw += time.perf_counter() - t
+            fh.write(memoryview(frame).cast("B"))
+    v, n = scene.video, scene.frames - 2
+    frames = np.memmap(raw, np.uint8, "r", shape=(scene.frames, v.height, v.width, 3))
+    (tmp / "floor").mkdir(exist_ok=True)
+    t = time.perf_counter()
+    enc = Encoder(tmp / "floor", scene.name, v)
+    for f in range(scene.frames):
+        enc.write(frames[f])
+    enc.close()
+    floor = time.perf_counter() - t
+    del frames
+    raw.unlink()
+    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + timings["simulate"]), "floor_s": floor,
+            "encode_fps": scene.frames / floor}
+
+
+def timed_render(scene, arch, tmp, warm_scene=None) -> tuple[float, dict]:
+    """Wall time of pipeline.render, after a warm-up render (Taichi init, kernel cache); and its metadata."""
+    from . import pipeline
+    if warm_scene is not None:
+        pipeline.render(warm_scene, tmp / "warm", arch=arch)
+    t = time.perf_counter()
+    meta = pipeline.render(scene, tmp / "timed", arch=arch)
+    return time.perf_counter() - t, meta
+
+
+def phase_e2e(cfg, arch, tmp) -> dict:
+    scene = chaos_scene(cfg)
+    one = scene.replace(video={"duration": 1.0 / scene.video.fps})
+    wall, meta = timed_render(scene, arch, tmp, one)
+    fixed, _ = timed_render(one, arch, tmp)  # what every render pays besides its frames
+    return {"wall_s": wall, "frames": meta["frames"], "timings": meta["timings_s"], "fixed_s": fixed}
+
+
+def phase_fractal(cfg, arch, tmp) -> dict:
+    from .scene import load
+    scene = load(FRACTAL, [f"video.duration={cfg['fractal_s']}"] if cfg["fractal_s"] else [])
+    warm = load(FRACTAL, ["video.width=64", "video.height=36", "pendulums.count=2304", "video.duration=0.05"])
+    wall, meta = timed_render(scene, arch, tmp, warm)
+    return {"wall_s": wall, "frames": meta["frames"], "fps": meta["frames"] / wall, "timings": meta["timings_s"],
+            "integrator": meta["integrator"]}
+
+
+PHASES = {"sim": phase_sim, "encode": phase_encode, "e2e": phase_e2e, "fractal": phase_fractal}
+
+
+# ---------------------------------------------------------------- report
+
+def summarise(res: dict, quick: bool, wall: float) -> dict:
+    from .encode import ffmpeg_version
+
+    at = {f"{r['system']}_{r['precision']}": r["speedup"] for r in res["sim"]["rows"] if r["n"] == 10**5}
+    enc, e2e, fr = res["encode"], res["e2e"], res["fractal"]
+    rep = {"quick": quick, "wall_s": wall, "created": time.strftime("%Y-%m-%d %H:%M:%S"),
+           "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "python": platform.python_version(),
+                       "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
+           "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
+           "sim_speedup_vs_numpy_1e5": at["rigid_f64"], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
+           "fractal_fps": fr["fps"], "fractal_peak_mem_mb": fr["peak_mem_mb"],
+           "draw_fps": enc["draw_fps"], "sim_draw_fps": enc["sim_draw_fps"], "encode_fps": enc["encode_fps"],
+           "end_to_end_s": e2e["wall_s"], "encode_floor_s": enc["floor_s"], "frames": e2e["frames"],
+           "end_to_end_fixed_s": e2e["fixed_s"], "end_to_end_timings": e2e["timings"], "fractal": fr,
+           "sim": res["sim"]["rows"], "peak_mem_mb": {k: v["peak_mem_mb"] for k, v in res.items()}, "targets": {}}
+    for key, op, goal in TARGETS:
+        val = rep[key]
+        met = val <= goal if op == "<=" else val >= goal if op == ">=" else val < goal
+        rep["targets"][key] = {"value": val, "goal": f"{op} {goal:g}", "met": met, "value_over_goal": val / goal}
+    return rep
+
+
+def cpu_model() -> str:
+    try:
+        return next(x.split(":", 1)[1].strip() for x in open("/proc/cpuinfo") if x.startswith("model name"))
+    except (OSError, StopIteration):
+        return platform.processor() or "unknown"
+
+
+def table(head: list[str], rows: list[list]) -> list[str]:
+    return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)] + ["| " + " | ".join(map(str, r)) + " |"
+                                                                       for r in rows]
+
+
+def markdown(r: dict) -> str:
+    m, t, fr, i = r["machine"], r["end_to_end_timings"], r["fractal"], r["fractal"]["integrator"]
+    missed = [k for k, g in r["targets"].items() if not g["met"]]
+    out = [f"# pendulum bench{' --quick' if r['quick'] else ''}", "",
+           f"{r['created']}, {m['cpus']} CPUs ({m['cpu']}), Python {m['python']}, numpy {m['numpy']}, ffmpeg "
+           f"{m['ffmpeg']}. Every figure comes from this one run ({r['wall_s']:.0f} s).", "", "## Targets", ""]
+    out += table(["target", "measured", "goal", "met", "measured / goal"],
+                 [[k, f"{g['value']:.3g}", g["goal"], "yes" if g["met"] else "**no**",
+                   f"{g['value_over_goal']:.2f}"] for k, g in r["targets"].items()])
+    if missed:
+        out += ["", f"Missed: {', '.join(missed)}. What limits it is profiled in benchmarks/README.md."]
+    if r["quick"]:
+        out += ["", "Quick run: short videos, where the fixed cost of a render and the easy early frames weigh "
+                "most; only the full run speaks to the targets."]
+    out += ["", f"## rigid_chaos, 1280x720 at 60 fps, {r['frames']} frames, N=100, MP4 + GIF", ""]
+    out += table(["measure", "value"], [
+        ["simulate + draw, no encoding", f"{r['sim_draw_fps']:.0f} fps"],
+        ["draw only", f"{r['draw_fps']:.0f} fps"],
+        ["encode only: the floor (same frames, same Encoder)",
+         f"{r['encode_fps']:.0f} fps, {r['encode_floor_s']:.2f} s"],
+        ["end-to-end render", f"{r['end_to_end_s']:.2f} s"],
+        ["end-to-end / floor", f"**{r['end_to_end_over_encode_floor']:.3f}**"],
+        ["fixed cost in it (a one-frame render)", f"{r['end_to_end_fixed_s']:.2f} s"],
+        ["render's split: simulate / draw / waiting for the encoder",
+         f"{t['simulate']:.2f} / {t['draw']:.2f} / {t['encode']:.2f} s"]])
+    out += ["", "## fractal: one pendulum per pixel, 1280x720", ""]
+    out += table(["measure", "value"], [
+        ["frames", fr["frames"]],
+        ["integrator", f"{i['method']} dt={i['dt']:.4g} s x{i['substeps']} {i['precision']}"],
+        ["render wall, fps", f"{fr['wall_s']:.1f} s, **{fr['fps']:.2f} fps**"],
+        ["simulate / draw / waiting for the encoder",
+         f"{fr['timings']['simulate']:.1f} / {fr['timings']['draw']:.1f} / {fr['timings']['encode']:.1f} s"],
+        ["peak memory, process tree", f"{fr['peak_mem_mb']:.0f} MB"]])
+    out += ["", "## Simulation: million pendulum-substeps per second (RK4, dt ~1e-3; Taichi on all cores, "
+            "numpy on one)", ""]
+    out += table(["system", "precision", "N", "Taichi", "numpy", "speedup", "max diff after 100 steps (N=100)"],
+                 [[s["system"], s["precision"], f"{s['n']:.0e}", f"{s['taichi'] / 1e6:.2f}",
+                   f"{s['numpy'] / 1e6:.2f}", f"{s['speedup']:.2f}", f"{s['agree']:.1e}"] for s in r["sim"]])
+    out += ["", "## Peak memory per phase (process tree)", ""]
+    out += table(["phase", "MB"], [[k + (" (includes the memory-mapped raw frames)" if k == "encode" else ""),
+                                    f"{v:.0f}"] for k, v in r["peak_mem_mb"].items()])
+    return "\n".join(out) + "\n"

@@ -1,0 +1,88 @@
+"""`pendulum bench --quick` writes its report; the fractal preset renders (small) one pendulum per pixel."""
+import json
+import math
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from conftest import run_cli
+from render import pipeline
+from render.scene import load
+
+KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps", "fractal_peak_mem_mb",
+        "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
+
+
+@pytest.mark.slow
+def test_bench_quick_writes_report_json_and_md(tmp_path):
+    out = tmp_path / "bench"
+    r = run_cli("bench", "--quick", "--out", out, timeout=600)
+    assert r.returncode == 0, r.stderr
+    rep = json.loads((out / "report.json").read_text())
+    for key in KEYS:
+        val = rep[key]
+        assert isinstance(val, (int, float)) and not isinstance(val, bool), (key, val)
+        assert math.isfinite(val) and val > 0, (key, val)
+    assert rep["quick"] is True
+    assert set(rep["targets"]) == set(KEYS[:4]) and all(isinstance(t["met"], bool) for t in rep["targets"].values())
+    cases = {(s["system"], s["precision"]) for s in rep["sim"] if s["n"] == 10**5}
+    assert cases == {("rigid", "f32"), ("rigid", "f64"), ("elastic", "f32"), ("elastic", "f64")}
+    # the numpy baseline integrates the same equations: f64 agrees to round-off, f32 to its own precision
+    for s in rep["sim"]:
+        assert s["agree"] < (1e-9 if s["precision"] == "f64" else 1e-3), s
+    md = (out / "report.md").read_text()
+    assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md
+    assert not list(out.glob(".*")), "temporary files left behind"
+
+
+def small_fractal(w=64, h=36, seconds=0.2):
+    return load("fractal", [f"video.width={w}", f"video.height={h}", f"pendulums.count={w * h}",
+                            f"video.duration={seconds}", "video.gif_width=32"])
+
+
+def test_fractal_preset_is_a_full_720p_grid_without_trails_or_rods():
+    s = load("fractal")
+    assert (s.video.width, s.video.height, s.pendulums.count) == (1280, 720, 1280 * 720)
+    assert s.pendulums.layout == "grid" and s.effects == ("fractal",)
+
+
+def test_fractal_renders_one_pendulum_per_pixel(tmp_path):
+    scene = small_fractal()
+    frames = []
+    meta = pipeline.render(scene, tmp_path, frame_hook=lambda f, fr: frames.append(fr.copy()))
+    frames = np.stack(frames)
+    assert frames.shape == (scene.frames, 36, 64, 3)
+    assert sorted(meta["kernels"]) == ["fractal_colour", "rigid_advance"]
+    assert not [f for f in meta["fields"] if "trail" in f or f == "canvas.frame"], meta["fields"]
+    # frame 0 colours each pixel by its starting angles: theta1 = -pi..pi left to right, theta2 = pi..-pi down
+    th1, th2 = np.meshgrid(np.linspace(-np.pi, np.pi, 64), np.linspace(np.pi, -np.pi, 36))
+    want = 0.5 + 0.5 * np.stack([np.sin(th1), np.sin(th2), np.cos(th1 + th2)], axis=-1)
+    assert np.abs(frames[0].astype(int) - np.round(want * 255)).max() <= 1
+    assert (frames[-1] != frames[0]).any()  # the pendulums move
+    video = iio.imread(tmp_path / "fractal" / "fractal.mp4")
+    assert video.shape == frames.shape
+
+
+def test_fractal_frames_do_not_depend_on_thread_count(tmp_path):
+    runs = []
+    for threads in (1, 2):
+        frames = []
+        pipeline.render(small_fractal(seconds=0.1), tmp_path / str(threads), threads=threads,
+                        frame_hook=lambda f, fr: frames.append(fr.tobytes()))
+        runs.append(frames)
+    assert runs[0] == runs[1]
+
+
+def test_serial_and_parallel_drawing_give_the_same_bytes(tmp_path):
+    """Few CPU threads draw serially with a plain max; more threads (and CUDA) use atomic max in parallel."""
+    from render.canvas import SERIAL_MAX_THREADS
+    assert SERIAL_MAX_THREADS < 8
+    scene = load("rigid_chaos", ["video.width=320", "video.height=180", "video.duration=1", 'video.formats=["mp4"]'])
+    runs = []
+    for threads in (1, 8):  # 8 > canvas.SERIAL_MAX_THREADS: the parallel, atomic path even on a 2-core CPU
+        frames = []
+        pipeline.render(scene, tmp_path / str(threads), threads=threads,
+                        frame_hook=lambda f, fr: frames.append(fr.tobytes()))
+        runs.append(frames)
+    assert runs[0] == runs[1]
