@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import importlib.util
 import os
 import signal
 import tempfile
@@ -54,8 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     ls.set_defaults(func=cmd_presets)
 
     for name in MODULES:
-        if importlib.util.find_spec(f"render.{name}") is not None:  # TODO(before release): drop this guard
-            importlib.import_module(f"render.{name}").add_parser(sub)
+        importlib.import_module(f"render.{name}").add_parser(sub)
     return p
 
 
