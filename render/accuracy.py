@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from . import reference, runtime
-from .pipeline import make_system, write_atomic
+from .atomic import write_atomic
+from .pipeline import make_system
 from .scene import METHODS, PRECISIONS, load
 
 COLUMNS = ("system", "method", "precision", "dt", "traj_error", "energy_drift", "ns_per_step", "order")

@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 from . import __version__, gallery
+from .atomic import write_atomic
 from .cli import add_common, check_writable, progress_wanted
 from .scene import SCHEMA, SceneError, list_presets, load, parse_override, preset_path
 
@@ -325,7 +326,7 @@ def run(args) -> int:
     wall = time.perf_counter() - t0
     record = {"package": __version__, "mode": mode, "wall_s": round(wall, 3), "results": ordered}
     out_root.mkdir(parents=True, exist_ok=True)  # absent when nothing rendered, e.g. every preset was bad
-    gallery.write_atomic(out_root / "batch.json", json.dumps(record, indent=2) + "\n")
+    write_atomic(out_root / "batch.json", json.dumps(record, indent=2) + "\n")
     index = gallery.write_index(out_root, [(r["preset"], r["error"]) for r in ordered if r["status"] == "failed"])
     print(gallery.summary_table(ordered))
     counts = {s: sum(r["status"] == s for r in ordered) for s in ("ok", "skipped", "failed")}

@@ -46,7 +46,7 @@ def run(args) -> int:
         args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
         return 0
     from .cli import check_writable
-    from .pipeline import write_atomic
+    from .atomic import write_atomic
 
     check_writable(args.out)
     t0, res = time.perf_counter(), {}

@@ -10,12 +10,11 @@ from __future__ import annotations
 import datetime
 import html
 import json
-import os
-import tempfile
 from pathlib import Path
 from urllib.parse import quote
 
 from . import __version__
+from .atomic import write_atomic
 
 CSS = """
 body{font:14px/1.4 system-ui,sans-serif;margin:2em;background:#111;color:#ddd}
@@ -147,19 +146,6 @@ def _size(n) -> str:
     if not isinstance(n, int):
         return "?"
     return f"{n / 1e6:.1f} MB" if n >= 1e6 else f"{n / 1e3:.0f} kB"
-
-
-def write_atomic(path: Path, text: str):
-    """Readers (a browser, a second batch) never see a half-written page."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def summary_table(rows: list[dict]) -> str:

@@ -2,9 +2,7 @@
 from __future__ import annotations
 
 import json
-import os
 import sys
-import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -12,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, runtime
+from .atomic import replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
 
 SYSTEMS = {}
@@ -58,18 +57,6 @@ def output_dir(path: Path):
                 path.rmdir()
             except OSError:
                 pass
-        raise
-
-
-def write_atomic(path: Path, data: bytes):
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
         raise
 
 
@@ -126,16 +113,8 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
                 rows.setdefault(k, []).append(v)
             bar.update()
     out_file = Path(out_file)
-    with output_dir(out_file.parent):
-        fd, tmp = tempfile.mkstemp(prefix=f".{out_file.name}.", suffix=".npz", dir=out_file.parent)
-        os.close(fd)
-        try:
-            np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, out_file)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+    with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
+        np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings}
 
 

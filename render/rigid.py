@@ -5,7 +5,6 @@ import math
 import numpy as np
 import taichi as ti
 
-from . import runtime
 from .system import System
 
 

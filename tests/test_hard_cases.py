@@ -17,7 +17,6 @@ from hypothesis import strategies as st
 
 from conftest import ROOT, make_scene, run_cli
 from render import pipeline, runtime
-from render.system import SimulationError
 
 FAN = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
 
