@@ -79,7 +79,6 @@ class System(runtime.Launcher):
             self.e0 = runtime.field("energy.e0", real, self.n)
             self.escale = runtime.field("energy.scale", real, self.n)
             self.drift = runtime.field("energy.max_drift", real, ())
-        self.pos = None  # bob positions for drawing, allocated by the canvas's request (want_positions)
 
     # --------------------------------------------------------------- per-system parts
     def omega_max(self) -> float:
