@@ -38,8 +38,9 @@ def mp4_args(video) -> list[str]:
 
 def gif_args(video) -> list[str]:
     fps = min(video.gif_fps, video.fps)
+    width = min(video.gif_width, video.width)  # downscale only: a small video keeps its own size
     # eof_action=pass: the last input frame always counts, so a one-frame video still makes a GIF
-    graph = (f"fps={fps}:eof_action=pass,scale={video.gif_width}:-2:flags=lanczos,split[a][b];"
+    graph = (f"fps={fps}:eof_action=pass,scale={width}:-2:flags=lanczos,split[a][b];"
              f"[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer:bayer_scale=3")
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
 
