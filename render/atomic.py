@@ -5,18 +5,29 @@ from contextlib import contextmanager
 from pathlib import Path
 
 
-@contextmanager
-def replacing(path: Path, suffix: str = ".part"):
-    """Yield a hidden temporary path beside `path`; rename it onto `path` if the block succeeds, else remove it."""
+def temp_beside(path: Path, suffix: str = ".part") -> Path:
+    """A new, empty, hidden file in the same directory as `path` (so the final rename is atomic)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     os.close(fd)
+    return Path(tmp)
+
+
+def publish(tmp: Path, path: Path):
+    """Rename a finished temporary file onto its final path, readable like any other output."""
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+
+
+@contextmanager
+def replacing(path: Path, suffix: str = ".part"):
+    """Yield a temporary path beside `path`; publish it onto `path` if the block succeeds, else remove it."""
+    tmp = temp_beside(path, suffix)
     try:
-        yield Path(tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
+        yield tmp
+        publish(tmp, Path(path))
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
 
 

@@ -21,6 +21,8 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 
+from .atomic import publish, temp_beside
+
 try:
     import fcntl
 except ImportError:  # not POSIX: default pipe sizes
@@ -94,8 +96,7 @@ class Encoder:
         try:
             for fmt in formats or video.formats:
                 final = out_dir / f"{name}.{fmt}"
-                fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=f".{fmt}.part", dir=out_dir)
-                os.close(fd)
+                tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
                        "-s", f"{video.width}x{video.height}", "-r", str(video.fps), "-i", "-", "-an",
@@ -104,10 +105,10 @@ class Encoder:
                     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
                                             start_new_session=True)  # Ctrl-C reaches us, and we clean up
                 except BaseException:
-                    Path(tmp).unlink(missing_ok=True)
+                    tmp.unlink(missing_ok=True)
                     log.close()
                     raise
-                self.targets.append(_Target(final, Path(tmp), proc, log))
+                self.targets.append(_Target(final, tmp, proc, log))
         except BaseException:
             self.abort()
             raise
@@ -155,8 +156,7 @@ class Encoder:
             raise EncodeError(f"ffmpeg failed: {msg}")
         sizes = {}
         for t in self.targets:
-            os.chmod(t.tmp, 0o644)
-            os.replace(t.tmp, t.final)
+            publish(t.tmp, t.final)
             sizes[t.final.name] = t.final.stat().st_size
             t.log.close()
         self.targets = []

@@ -11,16 +11,14 @@ import numpy as np
 
 from . import __version__, runtime
 from .atomic import replacing, write_atomic
+from .elastic import Elastic
+from .rigid import Rigid
 from .system import DEFAULT_MAX_DRIFT
 
-SYSTEMS = {}
+SYSTEMS = {"rigid": Rigid, "elastic": Elastic}
 
 
 def make_system(scene):
-    if not SYSTEMS:
-        from .elastic import Elastic
-        from .rigid import Rigid
-        SYSTEMS.update(rigid=Rigid, elastic=Elastic)
     return SYSTEMS[scene.system](scene)
 
 

@@ -177,12 +177,11 @@ class System(runtime.Launcher):
         self.launch(f"{self.NAME}_advance", self.substeps)
         self.t += self.substeps * self.h
 
-    def measure_energy(self, first: bool = False) -> float:
-        """Energies at this frame into self.e; returns the max relative drift so far."""
+    def measure_energy(self, first: bool = False):
+        """Energies at this frame into self.e, and the max relative drift so far into self.drift."""
         if first:
             self.drift[None] = 0.0
         self.launch(f"{self.NAME}_energy", int(first))
-        return float(self.drift[None])
 
     def check(self, frame: int, max_drift: float | None):
         """Watchdog, once per frame: NaN/inf anywhere, or energy drift beyond the tolerance."""
