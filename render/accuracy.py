@@ -16,19 +16,20 @@ from pathlib import Path
 
 import numpy as np
 
-from . import reference, runtime
+from . import reference, registry, runtime
 from .atomic import write_atomic
+from .options import check_writable
 from .pipeline import make_system
 from .scene import METHODS, PRECISIONS, load
 
 COLUMNS = ("system", "method", "precision", "dt", "traj_error", "energy_drift", "ns_per_step", "order")
 FPS = 10  # frames of 0.1 s: every dt in the ladders divides it exactly, so the step is exactly dt
-# Short-horizon cases: the presets' physics, their preset dt (1e-3) is on both ladders.
-CASES = {"rigid": ("classic", 2.0), "elastic": ("elastic_fan", 1.0)}
-LADDER = {"rigid": (2e-2, 1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4),
-          "elastic": (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)}
+# Short-horizon cases, one per system (its preset and horizon); the preset dt (1e-3) is on every ladder.
+CASES = {name: registry.get(name).ACCURACY_CASE for name in registry.names()}
+LADDER = {name: registry.get(name).ACCURACY_LADDER for name in registry.names()}
 QUICK_LADDER = (2e-3, 1e-3)
-UNITS = {"rigid": "max |Δθ| [rad]", "elastic": "max |Δx| of the bobs [m]"}
+UNITS = {name: registry.get(name).ERROR_UNIT for name in registry.names()}
+CHAOS = "rigid_chaos"  # the fan whose f32-vs-f64 divergence is charted
 LONG_DT, LONG_T, QUICK_LONG_T = 1e-3, 100.0, 5.0  # energy-drift run: 1e5 steps at the preset dt
 TIMING_N, QUICK_TIMING_N = 20000, 2000
 CHAOS_T, QUICK_CHAOS_T, CHAOS_FPS = 12.0, 3.0, 30
@@ -107,17 +108,14 @@ def ns_per_step(kernels: dict, rounds: int = 5) -> dict:
 
 
 def outer_bobs(scene, duration: float, fps: int = CHAOS_FPS) -> np.ndarray:
-    """Outer-bob positions (frames, N, 2) of a rigid scene sampled at fps, computed in float64 from the angles."""
-    scene = scene.replace(video={"fps": fps, "duration": duration}, effects=["rods"])
+    """Outer-bob positions (frames, N, 2) of a scene sampled at fps, computed in float64 from the state."""
+    scene = scene.replace(video={"fps": fps, "duration": duration}, effects=["bobs"])
     sim = make_system(scene)
-    l1, l2 = scene.pendulums.lengths
     frames = []
     for f in range(scene.frames):
         if f:
             sim.advance_frame()
-        th = sim.q.to_numpy().astype(np.float64)
-        frames.append(np.stack([l1 * np.sin(th[:, 0]) + l2 * np.sin(th[:, 1]),
-                                -l1 * np.cos(th[:, 0]) - l2 * np.cos(th[:, 1])], -1))
+        frames.append(reference.bob_positions(scene, sim.q.to_numpy().astype(np.float64))[:, -1])
     return np.array(frames)
 
 
@@ -140,7 +138,8 @@ def measure(systems, arch="cpu", quick=False, show=False):
         horizon = CASES[s][1]
         sc = case_scene(s, METHODS[s][0], "f64", LADDER[s][0], horizon)
         refs[s] = reference.solve(sc, reference.initial_state(sc), horizon)[0]
-    per_prec = sum(len(METHODS[s]) * len(ladder[s]) for s in systems) + 1 + ("rigid" in systems)
+    chaos_on = load(CHAOS).system in systems
+    per_prec = sum(len(METHODS[s]) * len(ladder[s]) for s in systems) + 1 + chaos_on
     step = progress(per_prec * len(PRECISIONS), show)
     rows, energy, chaos = [], {}, {}
     for prec in ("f64", "f32"):  # f64 first: its figures are the ones the quality table leans on
@@ -177,10 +176,10 @@ def measure(systems, arch="cpu", quick=False, show=False):
             row["ns_per_step"] = ns[key] if key in ns else ns[(*key, row["dt"])]
         rows += block
         step(f"{prec}: timed {len(kernels)} kernels over N = {n_time}")
-        if "rigid" in systems:
-            chaos[prec] = outer_bobs(load("rigid_chaos").replace(integrator={"precision": prec}),
+        if chaos_on:
+            chaos[prec] = outer_bobs(load(CHAOS).replace(integrator={"precision": prec}),
                                      QUICK_CHAOS_T if quick else CHAOS_T)
-            step(f"rigid_chaos {prec}: divergence")
+            step(f"{CHAOS} {prec}: divergence")
     return rows, energy, chaos
 
 
@@ -200,9 +199,11 @@ def csv_text(rows) -> str:
 
 
 def md_text(rows, energy, quick: bool, note: str = "") -> str:
+    cases = ", ".join(f"{s} `{p}` at t = {t:g} s ({UNITS[s]})" for s, (p, t) in CASES.items()
+                      if any(r["system"] == s for r in rows))
     lines = ["# Accuracy vs. time", "",
-             "Trajectory error against scipy DOP853 (rtol 1e-13): rigid `classic` at t = 2 s in rad, elastic "
-             "`elastic_fan` at t = 1 s in m (max over pendulums and coordinates). energy_drift: max relative "
+             f"Trajectory error against scipy DOP853 (rtol 1e-13): {cases}; max over pendulums and "
+             "coordinates. energy_drift: max relative "
              "energy error over that horizon. ns_per_step: wall time of the advance kernel per pendulum-step "
              f"(N = {QUICK_TIMING_N if quick else TIMING_N}, best of 5 round-robin rounds; explicit methods "
              "timed once, as their cost per step does not depend on dt; implicit_midpoint on every rung). "
@@ -214,7 +215,8 @@ def md_text(rows, energy, quick: bool, note: str = "") -> str:
         steps = round((len(next(iter(energy.values()))) - 1) / FPS / LONG_DT)
         lines += ["", f"## Energy over {steps} steps at dt = {LONG_DT:g} s (energy_drift_*.png)", "",
                   "| system | method | precision | max rel. error, first third | last third |", "|" + "---|" * 5]
-        for (s, m, p), series in sorted(energy.items(), key=lambda kv: (kv[0][0] == "elastic", kv[0][2] == "f32")):
+        order = list(CASES)
+        for (s, m, p), series in sorted(energy.items(), key=lambda kv: (order.index(kv[0][0]), kv[0][2] == "f32")):
             a = np.abs(series[1:]).max(1)
             third = len(a) // 3
             lines.append(f"| {s} | {m} | {p} | {a[:third].max():.2e} | {a[-third:].max():.2e} |")
@@ -299,8 +301,8 @@ def add_parser(sub):
     p = sub.add_parser("accuracy", help="measure error vs. time of every integrator; charts and tables",
                        description="Work-precision and energy-drift charts per system, f32-vs-f64 divergence, "
                                    "and accuracy.csv/.md, measured against a scipy DOP853 reference.")
-    p.add_argument("--system", choices=("rigid", "elastic", "all"), default="all",
-                   help="which system to measure (default: all); rigid also draws divergence.png")
+    p.add_argument("--system", choices=(*registry.names(), "all"), default="all",
+                   help=f"which system to measure (default: all); the system of {CHAOS} also draws divergence.png")
     p.add_argument("--out", type=Path, default=Path("out/accuracy"), help="output directory (default: out/accuracy)")
     p.add_argument("--quick", action="store_true", help="two dt rungs, small N, short runs: a smoke test")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend for the kernels")
@@ -309,10 +311,8 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from .cli import check_writable
-
     check_writable(args.out)
-    systems = ("rigid", "elastic") if args.system == "all" else (args.system,)
+    systems = registry.names() if args.system == "all" else (args.system,)
     t0, load0 = time.perf_counter(), os.getloadavg()[0]
     rows, energy, chaos = measure(systems, args.arch, args.quick, show=not args.no_progress)
     rows.sort(key=lambda r: (systems.index(r["system"]), METHODS[r["system"]].index(r["method"]),

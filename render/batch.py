@@ -24,14 +24,11 @@ from pathlib import Path
 
 from . import __version__, gallery
 from .atomic import write_atomic
-from .cli import add_common, check_writable, progress_wanted
-from .scene import SCHEMA, SceneError, list_presets, load, parse_override, preset_path
+from .errors import BatchError, SceneError
+from .options import add_common, check_writable, progress_wanted
+from .scene import SCHEMA, list_presets, load, parse_override, preset_path
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
-
-
-class BatchError(RuntimeError):
-    """The batch could not run at all (e.g. no scheduler): exit 1."""
 
 
 def add_parser(sub):

@@ -18,8 +18,13 @@ from pathlib import Path
 
 import numpy as np
 
+from . import reference
+from .atomic import write_atomic
+from .errors import SimulationError
+from .options import check_writable
+
 CHAOS, FRACTAL = "rigid_chaos", "fractal"
-SYSTEMS = {"rigid": ("rigid_chaos", '["rods"]'), "elastic": ("elastic_fan", '["springs"]')}  # no energy
+SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the first gives the headline figure
 FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "fractal_s": None, "min_s": 0.3}
 QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "fractal_s": 0.5, "min_s": 0.1}
 TARGETS = [("end_to_end_over_encode_floor", "<=", 1.3), ("sim_speedup_vs_numpy_1e5", ">=", 10.0),
@@ -45,9 +50,6 @@ def run(args) -> int:
         result = PHASES[args.phase](cfg, args.arch, args.out)
         args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
         return 0
-    from .cli import check_writable
-    from .atomic import write_atomic
-
     check_writable(args.out)
     t0, res = time.perf_counter(), {}
     with tempfile.TemporaryDirectory(prefix="pendulum-bench-") as tmp:
@@ -82,7 +84,6 @@ def run_phase(name: str, args, tmp: Path) -> dict:
             proc.wait()
     code = proc.returncode
     if code != 0:
-        from .system import SimulationError  # the CLI's "failure while running": exit 1, one line
         raise SimulationError(f"bench phase {name!r} failed (exit {code}); see the messages above")
     out = json.loads(result.read_text())
     out["peak_mem_mb"] = max(peak / 2**20, out.pop("maxrss_mb"))  # /proc may be missing, or miss a spike
@@ -121,10 +122,10 @@ def phase_sim(cfg, arch, tmp) -> dict:
     rows = []
     for prec in ("f32", "f64"):
         runtime.init(arch, prec)
-        for system, (preset, effects) in SYSTEMS.items():
+        for preset in SIM_PRESETS:
             for n in cfg["ladder"]:
                 scene = load(preset, [f"pendulums.count={n}", 'integrator.method="rk4"', "integrator.dt=1e-3",
-                                      f'integrator.precision="{prec}"', f"effects={effects}"])
+                                      f'integrator.precision="{prec}"', 'effects=["bobs"]'])  # no energy
                 sim = pipeline.make_system(scene)
                 kern, q0, v0 = f"{sim.NAME}_advance", sim.q.to_numpy().T.copy(), sim.v.to_numpy().T.copy()
                 if n == cfg["ladder"][0]:  # first check that both integrate the same thing
@@ -136,7 +137,7 @@ def phase_sim(cfg, arch, tmp) -> dict:
                 base = Baseline(scene, q0, v0, sim.h)
                 taichi = rate(lambda k: (sim.launch(kern, k), ti.sync()), n, cfg["min_s"])
                 numpy = rate(lambda k: [base.step() for _ in range(k)], n, cfg["min_s"])
-                rows.append({"system": system, "precision": prec, "n": n, "taichi": taichi, "numpy": numpy,
+                rows.append({"system": scene.system, "precision": prec, "n": n, "taichi": taichi, "numpy": numpy,
                              "speedup": taichi / numpy, "agree": agree})
     return {"rows": rows}
 
@@ -157,41 +158,14 @@ def rate(step, n: int, min_s: float) -> float:
 
 
 class Baseline:
-    """The benchmark's numpy-vectorised baseline: the RK4 and forces of render/rigid.py and elastic.py."""
+    """The numpy-vectorised peer: RK4 on render/reference.py's independent model, in the run's precision,
+    on (D, N) arrays so that every row is contiguous."""
 
     def __init__(self, scene, q, v, h: float):
-        self.q, self.v, self.h, self.p = q, v, h, scene.pendulums
-        (self.m1, self.m2), (self.l1, self.l2) = self.p.masses, self.p.lengths
-        self.accel = self.rigid if scene.system == "rigid" else self.elastic
-
-    def rigid(self, q, v):
-        m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.p.gravity
-        d = q[0] - q[1]
-        sd, cd, den = np.sin(d), np.cos(d), 2 * m1 + m2 - m2 * np.cos(2 * d)
-        a1 = (-g * (2 * m1 + m2) * np.sin(q[0]) - m2 * g * np.sin(q[0] - 2 * q[1])
-              - 2 * sd * m2 * (v[1] * v[1] * l2 + v[0] * v[0] * l1 * cd)) / (l1 * den)
-        a2 = 2 * sd * (v[0] * v[0] * l1 * (m1 + m2) + g * (m1 + m2) * np.cos(q[0]) + v[1] * v[1] * l2 * m2 * cd)
-        return np.stack([a1, a2 / (l2 * den)])
-
-    def elastic(self, q, v):
-        k1, k2, d2 = self.p.stiffness / self.l1, self.p.stiffness / self.l2, q[2:] - q[:2]
-        r1, r2 = np.hypot(q[0], q[1]), np.hypot(d2[0], d2[1])
-        f1 = -k1 * (r1 - self.l1) / np.maximum(r1, 1e-12) * q[:2]
-        f2 = -k2 * (r2 - self.l2) / np.maximum(r2, 1e-12) * d2
-        a = np.concatenate([(f1 - f2) / self.m1, f2 / self.m2])
-        a[1::2] -= self.p.gravity
-        return a
+        self.scene, self.q, self.v, self.h = scene, q, v, h
 
     def step(self):
-        q, v, h, f = self.q, self.v, self.h, self.accel
-        a1 = f(q, v)
-        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
-        a2 = f(q2, v2)
-        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
-        a3 = f(q3, v3)
-        q4, v4 = q + h * v3, v + h * a3
-        a4 = f(q4, v4)
-        self.q, self.v = q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        self.q, self.v = reference.rk4_step(self.scene, self.q, self.v, self.h)
 
 
 def chaos_scene(cfg):
@@ -269,12 +243,13 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
     from .encode import ffmpeg_version
 
     at = {f"{r['system']}_{r['precision']}": r["speedup"] for r in res["sim"]["rows"] if r["n"] == 10**5}
+    headline = f"{res['sim']['rows'][0]['system']}_f64"
     enc, e2e, fr = res["encode"], res["e2e"], res["fractal"]
     rep = {"quick": quick, "wall_s": wall, "created": time.strftime("%Y-%m-%d %H:%M:%S"),
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "python": platform.python_version(),
                        "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
            "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
-           "sim_speedup_vs_numpy_1e5": at["rigid_f64"], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
+           "sim_speedup_vs_numpy_1e5": at[headline], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
            "fractal_fps": fr["fps"], "fractal_peak_mem_mb": fr["peak_mem_mb"],
            "draw_fps": enc["draw_fps"], "sim_draw_fps": enc["sim_draw_fps"], "encode_fps": enc["encode_fps"],
            "end_to_end_s": e2e["wall_s"], "encode_floor_s": enc["floor_s"], "frames": e2e["frames"],

@@ -70,13 +70,13 @@ class Canvas(runtime.Launcher):
             self.rgb = runtime.field("canvas.frame", ti.f32, (self.h, self.w), 3)
             self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
             # pixels per metre, the pivot at the centre: the full reach fits with a margin
-            self.scale = 0.46 * min(self.w, self.h) / sim.extent()
+            self.scale = 0.46 * min(self.w, self.h) / sim.reach()
             self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
-            self.amp = 0.035 * self.scale * min(sim.l1, sim.l2)  # coil amplitude
-            m = max(sim.m1, sim.m2)
-            self.r1 = max(2.0, 0.013 * self.h * (sim.m1 / m) ** (1 / 3))
-            self.r2 = max(2.0, 0.013 * self.h * (sim.m2 / m) ** (1 / 3))
-            self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, 2), 2)
+            self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
+            self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
+            self.tip = len(self.links) - 1
+            self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
+            self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
             self.trail = runtime.field("canvas.trail", ti.f32, (self.h, self.w), 3)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
@@ -173,41 +173,51 @@ class Canvas(runtime.Launcher):
                         self.plot(self.rgb, self.drawn, y, x, c * cov)
 
     # ------------------------------------------------------------ kernels, one per effect
+    @ti.func
+    def joint(self, i, j: ti.template()):
+        """Where link j of pendulum i starts: the pivot, or the previous bob."""
+        a = ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32)
+        if ti.static(j > 0):
+            a = self.pos[i, j - 1]
+        return a
+
     @ti.kernel
     def bob_pixels(self):
-        """World metres to pixels (y down), at frame times only."""
+        """The system's chain points, world metres to pixels (y down), at frame times only."""
         cx, cy = 0.5 * self.w, 0.5 * self.h
         for i in range(self.n):
-            p1, p2 = self.sim.bobs(i)
-            self.pos[i, 0] = ti.Vector([cx + self.scale * p1[0], cy - self.scale * p1[1]], ti.f32)
-            self.pos[i, 1] = ti.Vector([cx + self.scale * p2[0], cy - self.scale * p2[1]], ti.f32)
+            pts = self.sim.points(self.sim.q[i])
+            for j in ti.static(range(len(self.links))):
+                self.pos[i, j] = ti.Vector([cx + self.scale * pts[j, 0], cy - self.scale * pts[j, 1]], ti.f32)
 
     @ti.kernel
     def stamp_trails(self, first: ti.i32):
         """The outer bob's path since the last frame into the trail layer (compose_frame fades it)."""
         ti.loop_config(serialize=self.serial)
         for i in range(self.n):
-            p = self.pos[i, 1]
+            p = self.pos[i, self.tip]  # the last bob leaves the trail
             a = p if first else self.last[i]
             self.segment(self.trail, self.lit, a, p, self.lw, 0.9 * self.colour(i))
             self.last[i] = p
 
     @ti.kernel
     def draw_rods(self):
-        centre = ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32)
         ti.loop_config(serialize=self.serial)
-        for i, j in ti.ndrange(self.n, 2):
-            a = centre if j == 0 else self.pos[i, 0]
-            self.segment(self.rgb, self.drawn, a, self.pos[i, j], self.lw, 0.55 * self.colour(i) + 0.15)
+        for i in range(self.n):
+            for j in ti.static(range(len(self.links))):
+                if ti.static(self.links[j] == "rod"):
+                    self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
+                                 0.55 * self.colour(i) + 0.15)
 
     @ti.kernel
     def draw_spring_coils(self):
-        centre = ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32)
         ti.loop_config(serialize=self.serial)
-        for i, j, k in ti.ndrange(self.n, 2, COILS + 2):
-            a = centre if j == 0 else self.pos[i, 0]
-            self.segment(self.rgb, self.drawn, self.coil_node(a, self.pos[i, j], k),
-                         self.coil_node(a, self.pos[i, j], k + 1), self.lw, 0.55 * self.colour(i) + 0.15)
+        for i, k in ti.ndrange(self.n, COILS + 2):
+            for j in ti.static(range(len(self.links))):
+                if ti.static(self.links[j] == "spring"):
+                    a, b = self.joint(i, j), self.pos[i, j]
+                    self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
+                                 self.lw, 0.55 * self.colour(i) + 0.15)
 
     @ti.func
     def coil_node(self, a, b, k):
@@ -229,8 +239,9 @@ class Canvas(runtime.Launcher):
     @ti.kernel
     def draw_bobs(self):
         ti.loop_config(serialize=self.serial)
-        for i, j in ti.ndrange(self.n, 2):
-            self.disc(self.pos[i, j], self.r1 if j == 0 else self.r2, self.colour(i))
+        for i in range(self.n):
+            for j in ti.static(range(len(self.links))):
+                self.disc(self.pos[i, j], self.radii[j], self.colour(i))
         self.disc(ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
 
     @ti.kernel

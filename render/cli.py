@@ -2,17 +2,17 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import signal
-import tempfile
 import sys
 from pathlib import Path
 
-from .scene import SceneError
+from . import accuracy, batch, bench
+from .errors import BatchError, EncodeError, SceneError, SimulationError
+from .options import add_common, check_writable, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = ("accuracy", "batch", "bench")
+MODULES = (accuracy, batch, bench)
 
 
 class Terminated(BaseException):
@@ -52,33 +52,9 @@ def build_parser() -> argparse.ArgumentParser:
     ls = sub.add_parser("presets", help="list the presets, one line each")
     ls.set_defaults(func=cmd_presets)
 
-    for name in MODULES:
-        importlib.import_module(f"render.{name}").add_parser(sub)
+    for module in MODULES:
+        module.add_parser(sub)
     return p
-
-
-def add_common(p):
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a preset key, dotted, value in TOML (e.g. --set integrator.dt=1e-4); repeatable")
-    p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu",
-                   help="Taichi backend; cuda falls back to the CPU with a warning where there is none")
-
-
-def check_writable(path: Path, what: str = "--out"):
-    """Bad input if the output cannot be created; checked before any work so nothing is half-written."""
-    probe = path
-    while not probe.exists():
-        probe = probe.parent
-    try:
-        if not probe.is_dir():
-            raise NotADirectoryError(probe)
-        tempfile.TemporaryFile(dir=probe).close()  # os.access says yes to root even where writing fails
-    except OSError:
-        raise SceneError(f"{what} {path}: not a writable directory ({probe})") from None
-
-
-def progress_wanted(args) -> bool:
-    return not args.no_progress and sys.stderr.isatty()
 
 
 def cmd_render(args) -> int:
@@ -130,9 +106,6 @@ def cmd_presets(args) -> int:
 
 
 def main(argv=None) -> int:
-    from .encode import EncodeError
-    from .system import SimulationError
-
     def on_term(signum, frame):
         raise Terminated()
 
@@ -143,7 +116,7 @@ def main(argv=None) -> int:
     except SceneError as e:
         print(f"pendulum: error: {e}", file=sys.stderr)
         return 2
-    except (SimulationError, EncodeError) as e:
+    except (SimulationError, EncodeError, BatchError) as e:
         print(f"pendulum: failed: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

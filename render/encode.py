@@ -22,6 +22,7 @@ import imageio_ffmpeg
 import numpy as np
 
 from .atomic import publish, temp_beside
+from .errors import EncodeError
 
 try:
     import fcntl
@@ -48,10 +49,6 @@ def gif_args(video) -> list[str]:
 
 
 ARGS = {"mp4": mp4_args, "gif": gif_args}
-
-
-class EncodeError(RuntimeError):
-    pass
 
 
 class _Target:

@@ -9,17 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, runtime
+from . import __version__, registry, runtime
 from .atomic import replacing, write_atomic
-from .elastic import Elastic
-from .rigid import Rigid
 from .system import DEFAULT_MAX_DRIFT
-
-SYSTEMS = {"rigid": Rigid, "elastic": Elastic}
 
 
 def make_system(scene):
-    return SYSTEMS[scene.system](scene)
+    """The scene's system, built by the class the registry holds for it."""
+    return registry.get(scene.system)(scene)
 
 
 def progress_bar(total: int, desc: str, enabled: bool):

@@ -53,7 +53,10 @@ class Launcher:
     def launch(self, name: str, *args):
         if name not in launched:
             launched.append(name)
-        return getattr(self, name)(*args)
+        return self.kernel(name)(*args)
+
+    def kernel(self, name: str):
+        return getattr(self, name)
 
 
 allocated: dict[str, int] = {}  # field name -> bytes, since the last init

@@ -14,31 +14,38 @@ import re
 import tomllib
 from pathlib import Path
 
+from . import keys, registry
+from .errors import SceneError
+from .quality import integrator_for
+
 PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
-SYSTEMS = ("rigid", "elastic")
-METHODS = {
-    "rigid": ("symplectic_euler", "rk4", "implicit_midpoint"),
-    "elastic": ("symplectic_euler", "rk4", "verlet", "yoshida4"),
-}
+SYSTEMS = registry.names()
+METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
 FORMATS = ("mp4", "gif")
 LAYOUTS = ("fan", "grid")
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal")
-DEFAULT_EFFECTS = {
-    "rigid": ("rods", "bobs", "trails", "energy"),
-    "elastic": ("springs", "bobs", "trails", "energy"),
-}
+LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
 MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
 MAX_PIXELS = 3840 * 2160
 
 
-class SceneError(ValueError):
-    """Bad input: one line, naming the file and the key."""
-
-
 REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+
+
+# Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
+COMMON_PENDULUM_KEYS = {"count": REQUIRED, "layout": "fan", "spread": 1e-4, "gravity": 9.8, "damping": 0.0}
+
+
+def pendulum_keys(system: str | None) -> dict:
+    """Key -> default under [pendulums] for one system, or for any system (the union) when None."""
+    out = dict(COMMON_PENDULUM_KEYS)
+    for name in (SYSTEMS if system is None else (system,)):
+        for key, spec in registry.get(name).preset_keys().items():
+            out.setdefault(key, list(spec.default) if isinstance(spec, keys.Reals) else spec.default)
+    return out
 
 
 # The schema: section -> key -> default. A default of None means "derived" (see _derive).
@@ -47,11 +54,7 @@ SCHEMA: dict[str, object] = {
     "description": "",
     "system": REQUIRED,
     "effects": None,
-    "pendulums": {
-        "count": REQUIRED, "layout": "fan",
-        "theta1": math.pi, "theta2": math.pi, "omega1": 0.0, "omega2": 0.0, "spread": 1e-4,
-        "lengths": [1.0, 1.0], "masses": [1.0, 1.0], "gravity": 9.8, "stiffness": 2e3, "damping": 0.0,
-    },
+    "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64",
         "allow_unstable": False, "max_drift": None,
@@ -63,20 +66,25 @@ SCHEMA: dict[str, object] = {
 }
 
 
-@dataclasses.dataclass(frozen=True)
-class Pendulums:
-    count: int
-    layout: str
-    theta1: float
-    theta2: float
-    omega1: float
-    omega2: float
-    spread: float
-    lengths: tuple[float, float]
-    masses: tuple[float, float]
-    gravity: float
-    stiffness: float
-    damping: float
+class Pendulums(dict):
+    """The validated [pendulums] table: its keys depend on the system, read as attributes (p.count)."""
+
+    def __getattr__(self, key):
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+    def __hash__(self):
+        return hash(tuple(sorted(self.items())))
+
+    def _readonly(self, *args, **kwargs):
+        raise TypeError("a scene's pendulums are read-only; use Scene.replace")
+
+    __setitem__ = __delitem__ = __setattr__ = update = pop = clear = setdefault = _readonly
+
+    def __reduce__(self):  # pickling (batch workers) must not go through __setitem__
+        return Pendulums, (dict(self),)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -171,7 +179,6 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         raise SceneError(f"{src}: cannot read: {e}") from None
     raw.setdefault("name", path.stem)
     if quality is not None and raw.get("system") in SYSTEMS:  # otherwise validation names the bad system
-        from .quality import integrator_for
         raw.setdefault("integrator", {})
         if not isinstance(raw["integrator"], dict):
             raise SceneError(f"{src}: integrator: must be a table")
@@ -223,7 +230,10 @@ def _sections(schema) -> list[str]:
 
 def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     v = _Validator(src)
-    merged = v.merge(raw, SCHEMA, "")
+    system = raw.get("system")
+    known = isinstance(system, str) and system in SYSTEMS  # else build() names the bad value
+    schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
+    merged = v.merge(raw, schema, "")
     return v.build(merged)
 
 
@@ -239,6 +249,9 @@ class _Validator:
         for k, val in raw.items():
             key = prefix + k
             if k not in schema:
+                owners = [n for n in SYSTEMS if prefix == "pendulums." and k in registry.get(n).preset_keys()]
+                if owners:
+                    self.fail(key, f"is not a key of this system (it belongs to system {' and '.join(owners)})")
                 self.fail(key, "unknown key" + _hint(k, list(schema), prefix))
             if isinstance(schema[k], dict):
                 if not isinstance(val, dict):
@@ -282,12 +295,18 @@ class _Validator:
             self.fail(name, f"unknown value {val!r}{_hint(val, list(options))}; choose from {', '.join(options)}")
         return val
 
-    def pair(self, d, sec, key):
+    def reals(self, d, sec, key, n, lo=-math.inf, hi=math.inf, lo_open=False):
         val, name = d[sec][key], f"{sec}.{key}"
-        if not isinstance(val, list) or len(val) != 2:
-            self.fail(name, f"must be a list of two numbers, got {val!r}")
+        if not isinstance(val, list) or len(val) != n:
+            self.fail(name, f"must be a list of {_COUNT.get(n, n)} numbers, got {val!r}")
         sub = {sec: {f"{key}[{i}]": x for i, x in enumerate(val)}}
-        return tuple(self.real(sub, sec, f"{key}[{i}]", 0.0, 1e6, lo_open=True) for i in range(2))
+        return tuple(self.real(sub, sec, f"{key}[{i}]", lo, hi, lo_open) for i in range(n))
+
+    def declared(self, d, sec, key, spec):
+        """A value of a key a system declared (render/keys.py)."""
+        if isinstance(spec, keys.Reals):
+            return self.reals(d, sec, key, len(spec.default), spec.lo, spec.hi, spec.lo_open)
+        return self.real(d, sec, key, spec.lo, spec.hi, spec.lo_open)
 
     def strings(self, val, name, options):
         if not isinstance(val, list) or not val:
@@ -336,13 +355,13 @@ class _Validator:
         if layout == "grid" and count != video.width * video.height:
             self.fail("pendulums.count", f"a grid layout has one pendulum per pixel: "
                       f"{video.width}x{video.height} = {video.width * video.height}, got {count}")
-        vals = {k: self.real(d, "pendulums", k) for k in ("theta1", "theta2", "omega1", "omega2", "spread")}
-        lengths, masses = self.pair(d, "pendulums", "lengths"), self.pair(d, "pendulums", "masses")
-        g = self.real(d, "pendulums", "gravity", 0.0, 1e4)
-        k = self.real(d, "pendulums", "stiffness", 0.0, 1e12, lo_open=True)
-        damp = self.real(d, "pendulums", "damping", 0.0, 1e3)
-        return Pendulums(count, layout, vals["theta1"], vals["theta2"], vals["omega1"], vals["omega2"],
-                         vals["spread"], lengths, masses, g, k, damp)
+        out = {"count": count, "layout": layout}
+        out.update({k: self.declared(d, "pendulums", k, spec)
+                    for k, spec in registry.get(system).preset_keys().items()})
+        out["spread"] = self.real(d, "pendulums", "spread")
+        out["gravity"] = self.real(d, "pendulums", "gravity", 0.0, 1e4)
+        out["damping"] = self.real(d, "pendulums", "damping", 0.0, 1e3)
+        return Pendulums(out)
 
     def integrator(self, d, system) -> Integrator:
         method = self.choice(d["integrator"]["method"], "integrator.method", METHODS[system])
@@ -362,14 +381,22 @@ class _Validator:
 
     def effects(self, d, system, pend) -> tuple[str, ...]:
         given = d["effects"]
-        eff = list(DEFAULT_EFFECTS[system] if given is None else self.strings(given, "effects", EFFECTS))
+        cls = registry.get(system)
+        eff = list(cls.DEFAULT_EFFECTS if given is None else self.strings(given, "effects", EFFECTS))
         if pend.damping > 0 and "damping" not in eff:
             eff.append("damping")  # a damped scene always simulates its damping
         if "damping" in eff and pend.damping == 0:
             self.fail("effects", "lists 'damping' but pendulums.damping is 0")
-        if "springs" in eff and system != "elastic":
-            self.fail("effects", "'springs' needs system = \"elastic\" (a rigid pendulum has rods)")
+        for effect, link in LINK_EFFECTS.items():
+            if effect in eff and link not in cls.LINKS:
+                having = [n for n in SYSTEMS if link in registry.get(n).LINKS]
+                self.fail("effects", f"'{effect}' draws {link}s, and this system has none: its links are "
+                          f"{list(cls.LINKS)} (systems with {link}s: {', '.join(having)})")
         if "fractal" in eff:
+            if not cls.ANGLES:
+                self.fail("effects", "'fractal' colours pixels by link angles, and this system's state is not "
+                          "angles (systems with angles: " + ", ".join(n for n in SYSTEMS if registry.get(n).ANGLES)
+                          + ")")
             if pend.layout != "grid":
                 self.fail("effects", "'fractal' colours one pendulum per pixel and needs pendulums.layout = \"grid\"")
             clash = [e for e in eff if e in ("rods", "springs", "bobs", "trails")]
@@ -378,6 +405,9 @@ class _Validator:
         elif pend.layout == "grid":
             self.fail("pendulums.layout", "a grid of pendulums is drawn with effects = [\"fractal\"]")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
+
+
+_COUNT = {1: "one", 2: "two", 3: "three", 4: "four"}
 
 
 def _hint(word: str, options: list[str], prefix: str = "") -> str:

@@ -1,59 +1,51 @@
-"""What every pendulum system shares: state fields, the integrators, the time step and the watchdog.
+"""What every pendulum system shares: its declaration for the registry, state fields, the advance and energy
+kernels, the drawing contract and the watchdog.
 
-A subclass supplies the physics as Taichi functions (accel, energy, bobs) and its kernels; the integrator is
-chosen at compile time with ti.static, so a run compiles only the method it uses.
+A system module (render/systems/) subclasses System, declares what the registry and the scene loader need as
+class attributes, and writes its physics once as Taichi functions:
+- accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group of LANES), so the
+  same code runs one pendulum or several packed side by side;
+- energy(q, v) and points(q) for one pendulum's vectors.
+The integrators (render/integrators.py) call force(); the canvas reads only points() and the Python-side
+contract (LINKS, bob_sizes(), reach(), lengths).
 """
-
-import math
 
 import numpy as np
 import taichi as ti
 
-from . import runtime
-from .scene import Scene, SceneError
+from . import integrators, keys, runtime
+from .errors import SimulationError
 
-# dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
-# implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
-STABILITY = {"symplectic_euler": 2.0, "verlet": 2.0, "rk4": 2.785, "yoshida4": 1.573, "implicit_midpoint": 1.0}
-ORDER = {"symplectic_euler": 1, "verlet": 2, "rk4": 4, "yoshida4": 4, "implicit_midpoint": 2}
-SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
-AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
 DEFAULT_MAX_DRIFT = 0.05
-
-# Yoshida's 4th-order composition of three velocity-Verlet steps.
-_CBRT2 = 2.0 ** (1.0 / 3.0)
-YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
-YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
-
-
-class SimulationError(RuntimeError):
-    """A failure while running (exit 1), e.g. a numerical blow-up caught by the watchdog."""
-
-
-def timestep(scene: Scene, omega_max: float) -> tuple[float, int]:
-    """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
-    frame_dt = 1.0 / scene.video.fps
-    method, dt = scene.integrator.method, scene.integrator.dt
-    limit = STABILITY[method] / omega_max
-    if dt == "auto":
-        dt = min(AUTO_DT, SAFETY * limit)
-    elif dt > limit and not scene.integrator.allow_unstable:
-        raise SceneError(
-            f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
-            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s, so "
-            f"dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
-            f"or set integrator.allow_unstable = true to proceed anyway")
-    substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
-    return frame_dt / substeps, substeps
 
 
 class System(runtime.Launcher):
-    """Base of @ti.data_oriented systems. Subclasses set D (coordinates per pendulum) and NAME."""
+    """Base of @ti.data_oriented systems."""
 
-    D = 0
-    NAME = ""
+    # ---- the declaration (class attributes: read without a Taichi runtime) ----
+    SYSTEM = ""  # the preset's `system` value
+    NAME = ""  # prefix of this system's kernel names in metadata ("rigid_advance")
+    DOC = ""  # one line for `pendulum presets` and the README
+    D = 0  # coordinates per pendulum in q (and v)
+    LINKS: tuple[str, ...] = ()  # drawing contract: what joins pivot→bob 1→bob 2...: "rod" | "spring"
+    ANGLES = False  # q holds the links' angles (a fractal can colour by them)
+    KEYS: dict = {}  # preset keys under [pendulums] beyond the chain's (keys.chain) and the common ones
+    METHODS: tuple[str, ...] = ()  # integrators this system supports
+    DEFAULT_EFFECTS: tuple[str, ...] = ()
+    STATE: dict = {}  # `simulate`'s arrays: name -> ("q" | "v", shape per pendulum)
+    REFERENCE = ""  # the independent model in render/reference.py ("chain" | "springs")
+    ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
+    ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
+    ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
+    QUALITY: dict = {}  # --quality level -> integrator settings
+    LANES = 1  # pendulums per loop iteration of the advance kernel
 
-    def __init__(self, scene: Scene):
+    @classmethod
+    def preset_keys(cls) -> dict:
+        return keys.chain(len(cls.LINKS), cls.KEYS)
+
+    # ---- one instance per run ----
+    def __init__(self, scene):
         self.scene = scene
         p = scene.pendulums
         self.n = p.count
@@ -61,10 +53,10 @@ class System(runtime.Launcher):
         self.damped = scene.has("damping")
         self.damping = p.damping
         self.g = p.gravity
-        self.m1, self.m2 = p.masses
-        self.l1, self.l2 = p.lengths
-        self.h, self.substeps = timestep(scene, self.omega_max())
+        self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
+        self.h, self.substeps = integrators.timestep(scene, self.omega_max())
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
+        self.groups = -(-self.n // self.LANES)
         real = runtime.real()
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
@@ -75,83 +67,129 @@ class System(runtime.Launcher):
         self.v.from_numpy(v0.astype(np.float64 if real == ti.f64 else np.float32))
         self.bad[None] = self.n
         if scene.has("energy"):
+            self.floor = self.energy_floor()
             self.e = runtime.field("energy.e", real, self.n)
             self.e0 = runtime.field("energy.e0", real, self.n)
             self.escale = runtime.field("energy.scale", real, self.n)
             self.drift = runtime.field("energy.max_drift", real, ())
 
-    # --------------------------------------------------------------- per-system parts
+    def kernel(self, name: str):
+        """Kernels are logged under the system's prefix ("rigid_advance") and shared by every system."""
+        return {"advance": self.advance, "energy": self.energies}[name.removeprefix(f"{self.NAME}_")]
+
+    # --------------------------------------------------------------- per-system parts (Python)
     def omega_max(self) -> float:
         """Fastest rate in rad/s that limits the step (the stiffest mode, or a speed bound)."""
         raise NotImplementedError
 
+    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    def reach(self) -> float:
+        """How far from the pivot a bob can get, in m: the canvas frames the scene by it."""
+        raise NotImplementedError
+
+    def bob_sizes(self) -> tuple[float, ...]:
+        """Each bob's radius relative to the largest (as the cube root of its mass)."""
+        top = max(self.masses)
+        return tuple((m / top) ** (1 / 3) for m in self.masses)
+
     def initial_angles(self) -> tuple[np.ndarray, np.ndarray]:
-        """θ1, θ2 per pendulum: a fan θ2 − spread·i/count, or a θ1×θ2 grid over [−π, π]²."""
-        p, n = self.scene.pendulums, self.n
+        """Per pendulum, the angle and rate of every link, each (N, links).
+
+        A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]²."""
+        p, n, links = self.scene.pendulums, self.n, len(self.LINKS)
+        th = np.array([[p[f"theta{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
+        w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         if p.layout == "grid":
-            w, h = self.scene.video.width, self.scene.video.height
-            th1 = np.tile(np.linspace(-np.pi, np.pi, w), h)
-            th2 = np.repeat(np.linspace(np.pi, -np.pi, h), w)  # row 0 at the top of the frame
-            return th1, th2
-        i = np.arange(n, dtype=np.float64)
-        return np.full(n, p.theta1), p.theta2 - p.spread * i / n
+            wd, ht = self.scene.video.width, self.scene.video.height
+            th[:, 0] = np.tile(np.linspace(-np.pi, np.pi, wd), ht)
+            th[:, 1] = np.repeat(np.linspace(np.pi, -np.pi, ht), wd)  # row 0 at the top of the frame
+        else:
+            th[:, -1] = th[:, -1] - p.spread * np.arange(n, dtype=np.float64) / n
+        return th, w
 
-    # --------------------------------------------------------------- integrators
+    # --------------------------------------------------------------- per-system parts (Taichi)
     @ti.func
-    def step(self, q, v, h):
-        if ti.static(self.method == "symplectic_euler"):
-            q, v = self.symplectic_euler(q, v, h)
-        elif ti.static(self.method == "verlet"):
-            q, v = self.verlet(q, v, h)
-        elif ti.static(self.method == "yoshida4"):
-            q, v = self.verlet(q, v, YOSHIDA_W1 * h)
-            q, v = self.verlet(q, v, YOSHIDA_W0 * h)
-            q, v = self.verlet(q, v, YOSHIDA_W1 * h)
-        elif ti.static(self.method == "rk4"):
-            q, v = self.rk4(q, v, h)
-        elif ti.static(self.method == "implicit_midpoint"):
-            q, v = self.implicit_midpoint(q, v, h)
-        return q, v
+    def accel(self, q, v):
+        """Accelerations for lane matrices q, v (D × LANES)."""
+        raise NotImplementedError
 
     @ti.func
-    def force(self, q, v):
+    def energy(self, q, v):
+        """Total energy of one pendulum, zero at the hanging rest position."""
+        raise NotImplementedError
+
+    @ti.func
+    def points(self, q):
+        """The bobs of one pendulum as a (links × 2) matrix of positions in m, the pivot at the origin."""
+        raise NotImplementedError
+
+    # Canonical hooks for the implicit midpoint: a separable system with constant masses may take p = v.
+    @ti.func
+    def momenta(self, q, v):
+        return v
+
+    @ti.func
+    def velocities(self, q, p):
+        return p
+
+    @ti.func
+    def momentum_rate(self, q, v, p):
+        return self.force(q, v)
+
+    @ti.func
+    def p_scale(self, h):
+        """Converts a change of momentum into a change of position over a step, for the solver's tolerance."""
+        return h
+
+    # --------------------------------------------------------------- shared Taichi parts
+    @ti.func
+    def lane_force(self, q, v):
         a = self.accel(q, v)
         if ti.static(self.damped):
             a -= self.damping * v
         return a
 
     @ti.func
-    def symplectic_euler(self, q, v, h):
-        """The seed's v += a·h; x += v·h. Symplectic for the separable elastic system only: on the rigid
-        system (θ, ω) are not canonical, so its energy error grows slowly (see README, Accuracy vs. time)."""
-        v += h * self.force(q, v)
-        return q + h * v, v
+    def force(self, q, v):
+        """Accelerations with damping, for lane matrices or for one pendulum's vectors."""
+        if ti.static(len(q.get_shape()) == 1):
+            return self.lane_force(ti.Matrix.cols([q]), ti.Matrix.cols([v]))[:, 0]
+        else:
+            return self.lane_force(q, v)
 
     @ti.func
-    def verlet(self, q, v, h):
-        v += 0.5 * h * self.force(q, v)
-        q += h * v
-        return q, v + 0.5 * h * self.force(q, v)
+    def gather(self, g: ti.i32):
+        """Group g's pendulums as lane matrices; the last group repeats its last pendulum as padding."""
+        q = ti.Matrix.cols([self.q[ti.min(g * self.LANES + lane, self.n - 1)]
+                            for lane in ti.static(range(self.LANES))])
+        v = ti.Matrix.cols([self.v[ti.min(g * self.LANES + lane, self.n - 1)]
+                            for lane in ti.static(range(self.LANES))])
+        return q, v
 
     @ti.func
-    def rk4(self, q, v, h):
-        a1 = self.force(q, v)
-        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
-        a2 = self.force(q2, v2)
-        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
-        a3 = self.force(q3, v3)
-        q4, v4 = q + h * v3, v + h * a3
-        a4 = self.force(q4, v4)
-        return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    def scatter(self, g: ti.i32, q, v):
+        for lane in ti.static(range(self.LANES)):
+            i = g * self.LANES + lane
+            if i < self.n:
+                self.q[i], self.v[i] = q[:, lane], v[:, lane]
+                if not (ti.abs(q[:, lane]).max() < 1e30 and ti.abs(v[:, lane]).max() < 1e30):  # also NaN
+                    ti.atomic_min(self.bad[None], i)
 
-    @ti.func
-    def advance_one(self, i: ti.i32, substeps: ti.i32):
-        q, v = self.q[i], self.v[i]
-        for _ in range(substeps):
-            q, v = self.step(q, v, self.h)
-        self.q[i], self.v[i] = q, v
-        if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also false for NaN
-            ti.atomic_min(self.bad[None], i)
+    @ti.kernel
+    def advance(self, substeps: ti.i32):
+        """All pendulums `substeps` steps on: the state stays in registers for the whole frame."""
+        for g in range(self.groups):
+            q, v = self.gather(g)
+            for _ in range(substeps):
+                q, v = integrators.step(self, q, v, self.h)
+            self.scatter(g, q, v)
+
+    @ti.kernel
+    def energies(self, first: ti.i32):
+        for i in range(self.n):
+            self.energy_one(i, first)
 
     @ti.func
     def energy_one(self, i: ti.i32, first: ti.i32):
@@ -159,7 +197,7 @@ class System(runtime.Launcher):
         self.e[i] = e
         if first:
             self.e0[i] = e
-            self.escale[i] = ti.max(ti.abs(e), self.energy_floor())
+            self.escale[i] = ti.max(ti.abs(e), self.floor)
         d = (e - self.e0[i]) / self.escale[i]
         if ti.static(self.damped):
             d = ti.max(d, 0.0)  # damping may only remove energy; a gain is the error
@@ -167,10 +205,9 @@ class System(runtime.Launcher):
         if not ti.abs(d) < 1e30:
             ti.atomic_min(self.bad[None], i)
 
-    @ti.func
-    def energy_floor(self):
+    def energy_floor(self) -> float:
         """Energy scale for pendulums whose own energy is near zero."""
-        return 1e-3 * (self.m1 + self.m2) * ti.max(self.g, 1.0) * (self.l1 + self.l2)
+        return 1e-3 * sum(self.masses) * max(self.g, 1.0) * sum(self.lengths)
 
     # --------------------------------------------------------------- host side
     def advance_frame(self):
@@ -200,4 +237,6 @@ class System(runtime.Launcher):
                     f"{hint}")
 
     def state(self) -> dict[str, np.ndarray]:
-        raise NotImplementedError
+        """The arrays `simulate` writes for this frame, as STATE declares them."""
+        return {name: getattr(self, src).to_numpy().reshape(self.n, *shape)
+                for name, (src, shape) in self.STATE.items()}

@@ -5,12 +5,13 @@ import imageio.v3 as iio
 import numpy as np
 
 from conftest import run_cli
+from render import registry
 from render.accuracy import COLUMNS
 from render.scene import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
-PNGS = ("work_precision_rigid.png", "work_precision_elastic.png", "energy_drift_rigid.png",
-        "energy_drift_elastic.png", "divergence.png")
+PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_precision", "energy_drift")),
+        "divergence.png")
 
 
 def test_accuracy_quick_writes_tables_and_charts(tmp_path):
@@ -36,7 +37,7 @@ def test_accuracy_quick_writes_tables_and_charts(tmp_path):
 
     md = (out / "accuracy.md").read_text()
     assert "| " + " | ".join(COLUMNS) + " |" in md
-    table = [ln for ln in md.splitlines() if ln.startswith(("| rigid |", "| elastic |")) and ln.count("|") == 9]
+    table = [ln for ln in md.splitlines() if ln.startswith(tuple(f"| {s} |" for s in METHODS)) and ln.count("|") == 9]
     assert len(table) == len(rows)
     assert "## Energy over" in md
 

@@ -1,0 +1,111 @@
+"""The integration methods, each written once, and the step size that keeps them stable.
+
+A method works on any system: it needs only the system's `force(q, v)` (and, for the implicit midpoint, its
+canonical hooks `momenta`, `velocities`, `momentum_rate` and `p_scale`). States are "lane matrices": row k is
+coordinate k, column l is pendulum l of a group (see System.advance), so a method is plain matrix arithmetic.
+The method is chosen at compile time with ti.static, so a run compiles only the one it uses.
+"""
+import math
+
+import taichi as ti
+
+from .errors import SceneError
+
+# dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
+# implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
+STABILITY = {"symplectic_euler": 2.0, "verlet": 2.0, "rk4": 2.785, "yoshida4": 1.573, "implicit_midpoint": 1.0}
+ORDER = {"symplectic_euler": 1, "verlet": 2, "rk4": 4, "yoshida4": 4, "implicit_midpoint": 2}
+SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
+AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
+
+# Yoshida's 4th-order composition of three velocity-Verlet steps.
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
+YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
+
+
+def timestep(scene, omega_max: float) -> tuple[float, int]:
+    """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
+    frame_dt = 1.0 / scene.video.fps
+    method, dt = scene.integrator.method, scene.integrator.dt
+    limit = STABILITY[method] / omega_max
+    if dt == "auto":
+        dt = min(AUTO_DT, SAFETY * limit)
+    elif dt > limit and not scene.integrator.allow_unstable:
+        raise SceneError(
+            f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
+            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s, so "
+            f"dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
+            f"or set integrator.allow_unstable = true to proceed anyway")
+    substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
+    return frame_dt / substeps, substeps
+
+
+@ti.func
+def step(sys: ti.template(), q, v, h):
+    """One step of sys.method from (q, v)."""
+    if ti.static(sys.method == "symplectic_euler"):
+        q, v = symplectic_euler(sys, q, v, h)
+    elif ti.static(sys.method == "verlet"):
+        q, v = verlet(sys, q, v, h)
+    elif ti.static(sys.method == "yoshida4"):
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W0 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+    elif ti.static(sys.method == "rk4"):
+        q, v = rk4(sys, q, v, h)
+    elif ti.static(sys.method == "implicit_midpoint"):
+        q, v = implicit_midpoint(sys, q, v, h)
+    return q, v
+
+
+@ti.func
+def symplectic_euler(sys: ti.template(), q, v, h):
+    """The seed's v += a·h; x += v·h. Symplectic for a separable system (springs) only: on the rigid chain
+    (θ, ω) are not canonical, so its energy error grows slowly (see README, Accuracy vs. time)."""
+    v += h * sys.force(q, v)
+    return q + h * v, v
+
+
+@ti.func
+def verlet(sys: ti.template(), q, v, h):
+    v += 0.5 * h * sys.force(q, v)
+    q += h * v
+    return q, v + 0.5 * h * sys.force(q, v)
+
+
+@ti.func
+def rk4(sys: ti.template(), q, v, h):
+    a1 = sys.force(q, v)
+    q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
+    a2 = sys.force(q2, v2)
+    q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
+    a3 = sys.force(q3, v3)
+    q4, v4 = q + h * v3, v + h * a3
+    a4 = sys.force(q4, v4)
+    return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+
+
+@ti.func
+def column_norm_sqr(m):
+    """|column|² of each lane of a lane matrix."""
+    return ti.Vector([m[:, lane].norm_sqr() for lane in ti.static(range(m.get_shape()[1]))])
+
+
+@ti.func
+def implicit_midpoint(sys: ti.template(), q, v, h):
+    """The midpoint rule in canonical (q, p), solved by fixed-point iteration until every lane moves less
+    than sys.tol (at most 100 sweeps). It is symplectic only in canonical coordinates: applied to (θ, ω) of
+    a rigid chain its symplecticity defect shrinks only like h³ and energy creeps."""
+    p = sys.momenta(q, v)
+    q1, p1 = q + h * v, p + h * sys.momentum_rate(q, v, p)
+    pscale = sys.p_scale(h)
+    for _ in range(100):
+        qm, pm = 0.5 * (q + q1), 0.5 * (p + p1)
+        vm = sys.velocities(qm, pm)
+        qn, pn = q + h * vm, p + h * sys.momentum_rate(qm, vm, pm)
+        err = ti.max(column_norm_sqr(qn - q1), column_norm_sqr(pn - p1) * pscale * pscale).max()
+        q1, p1 = qn, pn
+        if err <= sys.tol * sys.tol:
+            break
+    return q1, sys.velocities(q1, p1)

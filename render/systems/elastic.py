@@ -1,0 +1,91 @@
+"""The elastic double pendulum: two springs (k = stiffness / rest length) and gravity, in Cartesian form."""
+import math
+
+import numpy as np
+import taichi as ti
+
+from ..keys import Real
+from ..system import System
+
+
+@ti.data_oriented
+class Elastic(System):
+    SYSTEM = "elastic"
+    NAME = "spring"
+    DOC = "two springs of rest lengths `lengths`, k = stiffness / rest length (Newton in x, y)"
+    D = 4  # q = (x1, y1, x2, y2) with the pivot at the origin, v likewise
+    LINKS = ("spring", "spring")
+    KEYS = {"stiffness": Real(2e3, 0.0, 1e12, lo_open=True)}  # Young's-modulus-like E, as in the seed
+    METHODS = ("symplectic_euler", "rk4", "verlet", "yoshida4")
+    DEFAULT_EFFECTS = ("springs", "bobs", "trails", "energy")
+    STATE = {"pos": ("q", (2, 2)), "vel": ("v", (2, 2))}
+    REFERENCE = "springs"
+    ERROR_UNIT = "max |Δx| of the bobs [m]"
+    ACCURACY_CASE = ("elastic_fan", 1.0)
+    ACCURACY_LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)
+    # From `pendulum accuracy` on elastic_fan: symplectic methods keep the energy error flat (verlet 7e-4,
+    # yoshida4 2e-6 after 1e5 steps) where RK4's creeps up. "auto" follows the spring stiffness.
+    QUALITY = {
+        "draft": {"method": "verlet", "dt": "auto", "precision": "f32"},
+        "standard": {"method": "verlet", "dt": "auto", "precision": "f64"},
+        "high": {"method": "yoshida4", "dt": "auto", "precision": "f64"},  # 6.5e-8 m at 1e-3
+        "reference": {"method": "yoshida4", "dt": 1e-4, "precision": "f64"},  # 5.7e-12 m, the reference's own
+    }
+
+    def __init__(self, scene):
+        p = scene.pendulums
+        (self.m1, self.m2), (self.l1, self.l2) = p.masses, p.lengths
+        self.k1, self.k2 = p.stiffness / p.lengths[0], p.stiffness / p.lengths[1]
+        super().__init__(scene)
+
+    def omega_max(self) -> float:
+        """Fastest linear mode of the two springs along the chain: sqrt of the top eigenvalue of M⁻¹K."""
+        k1, k2, m1, m2 = self.k1, self.k2, self.m1, self.m2
+        mk = np.array([[(k1 + k2) / m1, -k2 / m1], [-k2 / m2, k2 / m2]])
+        return math.sqrt(max(np.linalg.eigvals(mk).real))
+
+    def initial_state(self):
+        """Bobs at their rest lengths along the fan's angles, velocities from ω1, ω2."""
+        th, w = self.initial_angles()
+        (th1, th2), (w1, w2) = th.T, w.T
+        l1, l2 = self.l1, self.l2
+        x1, y1 = l1 * np.sin(th1), -l1 * np.cos(th1)
+        vx1, vy1 = l1 * w1 * np.cos(th1), l1 * w1 * np.sin(th1)
+        x2, y2 = x1 + l2 * np.sin(th2), y1 - l2 * np.cos(th2)
+        vx2, vy2 = vx1 + l2 * w2 * np.cos(th2), vy1 + l2 * w2 * np.sin(th2)
+        return np.stack([x1, y1, x2, y2], 1), np.stack([vx1, vy1, vx2, vy2], 1)
+
+    def reach(self) -> float:
+        """Reach of the outer bob: rest lengths plus the largest stretch energy allows (bounded)."""
+        return (self.l1 + self.l2) * 1.15
+
+    @ti.func
+    def spring_pull(self, dx, dy, k, rest):
+        """Force on the far end of a spring along (dx, dy) (guarded so a spring of zero length gives no NaN)."""
+        r = ti.sqrt(dx * dx + dy * dy)
+        pull = -k * (r - rest)
+        return pull * dx / ti.max(r, 1e-12), pull * dy / ti.max(r, 1e-12)
+
+    @ti.func
+    def accel(self, q, v):
+        x1, y1, x2, y2 = q[0, :], q[1, :], q[2, :], q[3, :]
+        f1x, f1y = self.spring_pull(x1, y1, self.k1, self.l1)
+        f2x, f2y = self.spring_pull(x2 - x1, y2 - y1, self.k2, self.l2)
+        return ti.Matrix.rows([(f1x - f2x) / self.m1, (f1y - f2y) / self.m1 - self.g,
+                               f2x / self.m2, f2y / self.m2 - self.g])
+
+    @ti.func
+    def energy(self, q, v):
+        p1, p2 = ti.Vector([q[0], q[1]]), ti.Vector([q[2], q[3]])
+        s1, s2 = p1.norm() - self.l1, (p2 - p1).norm() - self.l2
+        kin = 0.5 * self.m1 * (v[0] * v[0] + v[1] * v[1]) + 0.5 * self.m2 * (v[2] * v[2] + v[3] * v[3])
+        springs = 0.5 * self.k1 * s1 * s1 + 0.5 * self.k2 * s2 * s2
+        grav = self.m1 * self.g * (q[1] + self.l1) + self.m2 * self.g * (q[3] + self.l1 + self.l2)
+        return kin + springs + grav
+
+    @ti.func
+    def points(self, q):
+        return ti.Matrix([[q[0], q[1]], [q[2], q[3]]])
+
+
+SYSTEM = Elastic

@@ -1,0 +1,123 @@
+"""The package's structure: systems come from the registry, nothing else names one, and imports form no cycle."""
+import ast
+from pathlib import Path
+
+import pytest
+
+from render import integrators, reference, registry
+from render.quality import LEVELS
+from render.scene import EFFECTS, LINK_EFFECTS, load
+
+PKG = Path(__file__).resolve().parent.parent / "render"
+SYSTEM_DIR = PKG / "systems"
+
+
+def module_name(path: Path) -> str:
+    rel = path.relative_to(PKG.parent).with_suffix("")
+    parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+    return ".".join(parts)
+
+
+def imported_modules(path: Path, known: set[str]) -> set[str]:
+    """render.* modules a file imports anywhere in it (lazy imports inside functions included)."""
+    here = module_name(path)
+    package = here if path.name == "__init__.py" else here.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                base = ".".join(anchor + ([node.module] if node.module else []))
+            out.add(base)
+            out |= {f"{base}.{a.name}" for a in node.names}  # `from . import x` imports module x
+    return {m for m in out if m in known}
+
+
+def import_graph() -> dict[str, set[str]]:
+    files = sorted(PKG.rglob("*.py"))
+    known = {module_name(f) for f in files}
+    graph = {module_name(f): imported_modules(f, known) - {module_name(f)} for f in files}
+    # The registry imports every system module by discovery (importlib), which ast cannot see.
+    graph["render.registry"] |= {module_name(f) for f in SYSTEM_DIR.glob("*.py") if f.name != "__init__.py"}
+    return graph
+
+
+def find_cycle(graph):
+    state, stack = {}, []
+
+    def visit(node):
+        state[node] = "open"
+        stack.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == "open":
+                return stack[stack.index(nxt):] + [nxt]
+            if nxt not in state and (found := visit(nxt)):
+                return found
+        stack.pop()
+        state[node] = "done"
+        return None
+
+    for node in sorted(graph):
+        if node not in state and (found := visit(node)):
+            return found
+    return None
+
+
+def test_the_import_graph_of_render_has_no_cycle():
+    graph = import_graph()
+    assert {"render.batch", "render.options", "render.errors"} <= graph["render.cli"]  # the graph is read
+    assert find_cycle(graph) is None, " -> ".join(find_cycle(graph))
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_module_outside_the_systems_and_the_registry_names_a_system():
+    names = set(registry.names())
+    offenders = []
+    for path in sorted(PKG.rglob("*.py")):
+        if path.parent == SYSTEM_DIR or path.name == "registry.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Constant) and node.value in names:
+                offenders.append(f"{path.relative_to(PKG.parent)}:{node.lineno}: {node.value!r}")
+    assert not offenders, offenders
+
+
+def test_the_canvas_reads_only_the_drawing_contract():
+    """The canvas never reaches into a system's private fields (sim.m1, sim.l1, ...)."""
+    contract = {"points", "q", "n", "LINKS", "reach", "bob_sizes", "lengths"}
+    used = set()
+    for node in ast.walk(ast.parse((PKG / "canvas.py").read_text())):
+        if isinstance(node, ast.Attribute):
+            owner = node.value
+            if (isinstance(owner, ast.Name) and owner.id == "sim") or (
+                    isinstance(owner, ast.Attribute) and owner.attr == "sim"):
+                used.add(node.attr)
+    assert used and used <= contract, used - contract
+
+
+@pytest.mark.parametrize("name", registry.names())
+def test_every_system_declares_its_contract(name):
+    cls = registry.get(name)
+    assert cls.SYSTEM == name and cls.NAME and cls.DOC
+    assert cls.LINKS and set(cls.LINKS) <= set(LINK_EFFECTS.values())
+    assert cls.D > 0 and cls.METHODS and set(cls.METHODS) <= set(integrators.STABILITY)
+    assert set(cls.DEFAULT_EFFECTS) <= set(EFFECTS)
+    per_pendulum = {src: 1 for src in ("q", "v")}
+    for src, shape in cls.STATE.values():
+        size = 1
+        for s in shape:
+            size *= s
+        per_pendulum[src] = size
+    assert per_pendulum == {"q": cls.D, "v": cls.D}, cls.STATE
+    assert cls.REFERENCE in reference.MODEL_ACCEL
+    assert set(cls.QUALITY) == set(LEVELS) and all(q["method"] in cls.METHODS for q in cls.QUALITY.values())
+    preset, horizon = cls.ACCURACY_CASE
+    assert load(preset).system == name and horizon > 0 and 1e-3 in cls.ACCURACY_LADDER
+    assert {f"theta{k}" for k in range(1, len(cls.LINKS) + 1)} <= set(cls.preset_keys())
