@@ -1,0 +1,112 @@
+"""The triple pendulum against the independent N-link chain of render.reference (scipy DOP853), its energy,
+and the limit of a vanishing third mass, where its first two links are the double pendulum."""
+import math
+
+import numpy as np
+import pytest
+import taichi as ti
+
+from conftest import make_scene, run_cli
+from render import pipeline, reference, runtime
+
+PEND = {"theta1": 2.0, "theta2": -0.5, "theta3": 2.8, "omega1": 0.3, "omega2": -1.0, "omega3": 0.7,
+        "spread": 0.4, "lengths": [1.0, 0.7, 0.5], "masses": [1.5, 0.8, 1.2], "gravity": 9.81}
+
+
+def triple(count=5, duration=1.0, fps=20, method="rk4", dt=1e-3, **pend):
+    return make_scene("triple", count, effects=["energy"], pendulums={**PEND, **pend},
+                      integrator={"method": method, "dt": dt}, video={"fps": fps, "duration": duration})
+
+
+def run(scene):
+    runtime.init("cpu", scene.integrator.precision)
+    sim = pipeline.make_system(scene)
+    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        pass
+    return sim
+
+
+@ti.kernel
+def force_and_energy(sim: ti.template(), acc: ti.types.ndarray(), e: ti.types.ndarray()):
+    for i in range(sim.n):
+        a = sim.force(sim.q[i], sim.v[i])
+        for k in ti.static(range(sim.D)):
+            acc[i, k] = a[k]
+        e[i] = sim.energy(sim.q[i], sim.v[i])
+
+
+def test_accelerations_and_energy_match_the_chain_reference_at_random_states():
+    runtime.init("cpu", "f64")
+    scene = triple(64)
+    sim = pipeline.make_system(scene)
+    rng = np.random.default_rng(11)
+    q, v = rng.uniform(-np.pi, np.pi, (64, 3)), rng.normal(0, 2.0, (64, 3))
+    sim.q.from_numpy(q)
+    sim.v.from_numpy(v)
+    acc, e = np.zeros((64, 3)), np.zeros(64)
+    force_and_energy(sim, acc, e)
+    p = reference.params(scene)
+    np.testing.assert_allclose(acc, reference.chain_accel(q, v, p), rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(e, reference.chain_energy(q, v, p), rtol=1e-12, atol=1e-10)
+
+
+@pytest.mark.parametrize("method, tol", [("rk4", 2e-7), ("implicit_midpoint", 1e-3)])
+def test_trajectories_match_dop853(method, tol):
+    scene = triple(method=method)
+    sim = run(scene)
+    q_ref, v_ref = reference.solve(scene, reference.initial_state(scene), sim.t, rtol=1e-12, atol=1e-12)
+    err = np.abs(sim.q.to_numpy() - q_ref).max()
+    assert err < tol, err
+    assert np.abs(sim.v.to_numpy() - v_ref).max() < 100 * tol
+
+
+def test_rk4_order_is_four():
+    scene = triple(1, 1.0, fps=10, dt=4e-3)
+    ref = reference.solve(scene, reference.initial_state(scene), 0.9)[0]  # the last of 10 frames
+    errs = [np.abs(run(triple(1, 1.0, fps=10, dt=dt)).q.to_numpy() - ref).max() for dt in (4e-3, 2e-3, 1e-3)]
+    slope = np.polyfit(np.log([4e-3, 2e-3, 1e-3]), np.log(errs), 1)[0]
+    assert abs(slope - 4) < 0.3, (errs, slope)
+
+
+def energy_errors(scene):
+    """Max relative energy error over the pendulums, per frame."""
+    runtime.init("cpu", "f64")
+    sim, out = pipeline.make_system(scene), []
+    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        out.append(np.max(np.abs(sim.e.to_numpy() - sim.e0.to_numpy()) / sim.escale.to_numpy()))
+    return np.array(out)
+
+
+def test_energy_is_conserved():
+    """RK4 at dt 1e-3 over 20 s of chaotic triples: relative energy error below 1e-6. The implicit midpoint
+    (symplectic in (θ, p)) keeps its larger, second-order error bounded: no growth from the first third of
+    the run to the last."""
+    assert energy_errors(triple(4, 20.0, fps=10)).max() < 1e-6
+    err = energy_errors(triple(4, 30.0, fps=10, method="implicit_midpoint"))
+    third = len(err) // 3
+    assert err.max() < 1e-3 and err[-third:].max() < 2.0 * err[:third].max(), (err[:third].max(), err[-third:].max())
+
+
+def test_a_vanishing_third_mass_leaves_the_double_pendulum():
+    """m3 → 0: links 1 and 2 follow the rigid double pendulum with the same masses and lengths. (The step is
+    "auto": energy alone would let a 1e-6 kg bob spin ~1e5 rad/s, so the sound step limit is small.)"""
+    tri = run(triple(3, 2.0, dt="auto", masses=[1.5, 0.8, 1e-6]))
+    dbl = run(make_scene("rigid", 3, effects=["energy"], integrator={"method": "rk4", "dt": 1e-3},
+                         video={"fps": 20, "duration": 2.0},
+                         pendulums={k: v for k, v in PEND.items() if not k.endswith("3") and k not in (
+                             "lengths", "masses")} | {"lengths": [1.0, 0.7], "masses": [1.5, 0.8],
+                                                      "spread": 0.0}))
+    th = tri.q.to_numpy()
+    assert np.abs(th[:, :2] - dbl.q.to_numpy()[:1]).max() < 1e-5  # the double fan has spread 0: one motion
+    assert np.isfinite(th).all()
+
+
+def test_simulate_writes_three_angles(tmp_path):
+    out = tmp_path / "t.npz"
+    r = run_cli("simulate", "triple_classic", "--out", out, "--set", "video.duration=1", "--no-progress")
+    assert r.returncode == 0, r.stderr
+    data = np.load(out)
+    frames = 60  # 1 s at 60 fps, t = 0 included
+    assert data["theta"].shape == (frames, 1, 3) and data["omega"].shape == (frames, 1, 3)
+    assert data["energy"].shape == (frames, 1)
+    np.testing.assert_allclose(data["theta"][0, 0], [math.pi / 2, 3 * math.pi / 4, math.pi], atol=1e-15)
