@@ -36,7 +36,10 @@ REQUIRED = object()  # schema default for keys a preset must state: the scene is
 
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
-COMMON_PENDULUM_KEYS = {"count": REQUIRED, "layout": "fan", "spread": 1e-4, "gravity": 9.8, "damping": 0.0}
+# `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
+FAN_KEYS = {"gap": "spread", "spread": "gap"}
+COMMON_PENDULUM_KEYS = {"count": REQUIRED, "layout": "fan", "spread": 1e-4, "gap": None, "gravity": 9.8,
+                        "damping": 0.0}
 
 
 def pendulum_keys(system: str | None) -> dict:
@@ -57,7 +60,7 @@ SCHEMA: dict[str, object] = {
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64",
-        "allow_unstable": False, "max_drift": None,
+        "allow_unstable": False, "max_drift": None, "tolerance": 1e-3, "min_faithful": 0.1,
     },
     "video": {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
@@ -94,6 +97,8 @@ class Integrator:
     precision: str
     allow_unstable: bool
     max_drift: float | None
+    tolerance: float  # faithfulness: rad on any angle, or a fraction of the total length for positions
+    min_faithful: float  # the median pendulum must stay faithful this fraction of the duration
 
 
 @dataclasses.dataclass(frozen=True)
@@ -219,6 +224,8 @@ def _apply_override(raw: dict, item: str, src: str) -> None:
         if not isinstance(node, dict):
             raise SceneError(f"{src}: {'.'.join(parts[:i + 1])}: must be a table")
     node[parts[-1]] = value
+    if parts[:-1] == ["pendulums"] and parts[-1] in FAN_KEYS:  # --set of one form of the fan replaces the other
+        node.pop(FAN_KEYS[parts[-1]], None)
 
 
 def _sections(schema) -> list[str]:
@@ -229,7 +236,7 @@ def _sections(schema) -> list[str]:
 
 
 def from_dict(raw: dict, src: str = "<scene>") -> Scene:
-    v = _Validator(src)
+    v = _Validator(src, raw)
     system = raw.get("system")
     known = isinstance(system, str) and system in SYSTEMS  # else build() names the bad value
     schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
@@ -238,8 +245,9 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
 
 
 class _Validator:
-    def __init__(self, src: str):
+    def __init__(self, src: str, given: dict):
         self.src = src
+        self.given = given  # the keys as written, before defaults
 
     def fail(self, key: str, msg: str):
         raise SceneError(f"{self.src}: {key}: {msg}")
@@ -359,6 +367,11 @@ class _Validator:
         out.update({k: self.declared(d, "pendulums", k, spec)
                     for k, spec in registry.get(system).preset_keys().items()})
         out["spread"] = self.real(d, "pendulums", "spread")
+        if d["pendulums"]["gap"] is not None:
+            if "spread" in self.given.get("pendulums", {}):
+                self.fail("pendulums.gap", "give either pendulums.gap (between neighbours) or pendulums.spread "
+                          "(over the whole fan), not both")
+            out["spread"] = self.real(d, "pendulums", "gap") * count
         out["gravity"] = self.real(d, "pendulums", "gravity", 0.0, 1e4)
         out["damping"] = self.real(d, "pendulums", "damping", 0.0, 1e3)
         return Pendulums(out)
@@ -377,7 +390,9 @@ class _Validator:
         drift = d["integrator"]["max_drift"]
         if drift is not None:
             drift = self.real(d, "integrator", "max_drift", 0.0, 1e6, lo_open=True)
-        return Integrator(method, dt, prec, allow, drift)
+        tol = self.real(d, "integrator", "tolerance", 0.0, 1.0, lo_open=True)
+        least = self.real(d, "integrator", "min_faithful", 0.0, 1.0)
+        return Integrator(method, dt, prec, allow, drift, tol, least)
 
     def effects(self, d, system, pend) -> tuple[str, ...]:
         given = d["effects"]
