@@ -1,7 +1,8 @@
 """Reference trajectories from scipy's DOP853 at rtol ~1e-13, for measuring the Taichi integrators' error.
 
 Deliberately a different formulation from the systems in render/systems/, so a shared mistake cannot hide.
-It knows two models, not the systems: a system names its model (System.REFERENCE).
+It knows two models, not the systems: a system names its model (System.REFERENCE), a scene tells it
+(Scene.model), so this module imports nothing of the package.
 - "chain": any number of rigid links, Lagrange's equations in mass-matrix form M(θ)·θ'' = f(θ, ω) with
   M_ij = μ_ij l_i l_j cos(θ_i − θ_j), μ_ij the mass at or below link max(i, j), solved by elimination;
 - "springs": Newton's law with Hooke springs written out in Cartesian components.
@@ -14,8 +15,6 @@ import dataclasses
 
 import numpy as np
 from scipy.integrate import solve_ivp
-
-from . import registry
 
 RTOL = 1e-13  # DOP853 stays well-behaved down to ~100 ulps; tighter only adds round-off
 
@@ -36,7 +35,7 @@ def params(src) -> Params:
         return src
     p = src.pendulums
     damping = p.damping if src.has("damping") else 0.0
-    return Params(registry.get(src.system).REFERENCE, tuple(p.lengths), tuple(p.masses), p.gravity,
+    return Params(src.model, tuple(p.lengths), tuple(p.masses), p.gravity,
                   p.get("stiffness", 0.0), damping)
 
 
@@ -74,6 +73,12 @@ def _below(masses) -> list[list[float]]:
     """μ_ij: the total mass at or below link max(i, j)."""
     n = len(masses)
     return [[float(sum(masses[max(i, j):])) for j in range(n)] for i in range(n)]
+
+
+def chain_mass(th: np.ndarray, p: Params) -> np.ndarray:
+    """The mass matrix M(θ) of a chain, (N, links, links), for angles th of shape (N, links)."""
+    l = np.asarray(p.lengths)
+    return np.asarray(_below(p.masses)) * np.outer(l, l) * np.cos(th[:, :, None] - th[:, None, :])
 
 
 def chain_rows(th, w, p: Params) -> list:
@@ -146,9 +151,6 @@ def springs_energy(q: np.ndarray, v: np.ndarray, p: Params) -> np.ndarray:
 MODEL_ROWS = {"chain": chain_rows, "springs": springs_rows}
 MODEL_ACCEL = {"chain": chain_accel, "springs": springs_accel}
 MODEL_ENERGY = {"chain": chain_energy, "springs": springs_energy}
-# By system name, through each system's declared model.
-ACCEL = {name: MODEL_ACCEL[registry.get(name).REFERENCE] for name in registry.names()}
-ENERGY = {name: MODEL_ENERGY[registry.get(name).REFERENCE] for name in registry.names()}
 
 
 def accel(src, q, v) -> np.ndarray:

@@ -14,12 +14,13 @@ import taichi as ti
 
 ARCHES = ("cpu", "cuda")
 _current: tuple | None = None
+_generation = 0  # how many times Taichi was (re)initialised: fields of an older generation are gone
 launched: list[str] = []  # kernel names in first-launch order, since the last init
 
 
 def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) -> str:
     """(Re)initialise Taichi if the settings differ; returns the arch actually in use."""
-    global _current
+    global _current, _generation
     want = (arch, precision, threads)
     if _current is not None and _current[0] == want:
         launched.clear()
@@ -37,9 +38,14 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) 
     if arch == "cuda" and used == "cpu":
         print("warning: --arch cuda: no CUDA device found, running on the CPU", file=sys.stderr)
     _current = (want, used)
+    _generation += 1
     launched.clear()
     allocated.clear()
     return used
+
+
+def generation() -> int:
+    return _generation
 
 
 def real():

@@ -37,7 +37,6 @@ class System(runtime.Launcher):
     ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
     ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
     ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
-    QUALITY: dict = {}  # --quality level -> integrator settings
     LANES = 1  # pendulums per loop iteration of the advance kernel
 
     @classmethod
@@ -45,27 +44,31 @@ class System(runtime.Launcher):
         return keys.chain(len(cls.LINKS), cls.KEYS)
 
     # ---- one instance per run ----
-    def __init__(self, scene):
+    def __init__(self, scene, subset=None, allocate: bool = True):
+        """The scene's pendulums, or only those at the indices `subset` (the step is the whole scene's).
+        Without `allocate` it only plans: the initial state and the step, no Taichi field."""
         self.scene = scene
         p = scene.pendulums
-        self.n = p.count
+        self.count = p.count
         self.method = scene.integrator.method
         self.damped = scene.has("damping")
         self.damping = p.damping
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
-        self.h, self.substeps = integrators.timestep(scene, self.omega_max())
+        q0, v0 = self.initial_state()
+        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0))
+        if subset is not None:
+            q0, v0 = q0[subset], v0[subset]
+        self.n, self.subset = len(q0), subset
+        if not allocate:
+            return
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
         self.groups = -(-self.n // self.LANES)
         real = runtime.real()
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
         self.bad = runtime.field("watchdog.bad", ti.i32, ())
-        self.t = 0.0
-        q0, v0 = self.initial_state()
-        self.q.from_numpy(q0.astype(np.float64 if real == ti.f64 else np.float32))
-        self.v.from_numpy(v0.astype(np.float64 if real == ti.f64 else np.float32))
-        self.bad[None] = self.n
+        self.load(q0, v0)
         if scene.has("energy"):
             self.floor = self.energy_floor()
             self.e = runtime.field("energy.e", real, self.n)
@@ -73,14 +76,38 @@ class System(runtime.Launcher):
             self.escale = runtime.field("energy.scale", real, self.n)
             self.drift = runtime.field("energy.max_drift", real, ())
 
+    def load(self, q0: np.ndarray, v0: np.ndarray):
+        """Set the state (and the clock and the watchdog) to t = 0."""
+        dtype = np.float64 if runtime.real() == ti.f64 else np.float32
+        self.q.from_numpy(q0.astype(dtype))
+        self.v.from_numpy(v0.astype(dtype))
+        self.bad[None] = self.n
+        self.t = 0.0
+
+    def restart(self):
+        """Back to the initial state, as first built: the same frames follow again."""
+        q0, v0 = self.initial_state()
+        if self.subset is not None:
+            q0, v0 = q0[self.subset], v0[self.subset]
+        self.load(q0, v0)
+
     def kernel(self, name: str):
         """Kernels are logged under the system's prefix ("rigid_advance") and shared by every system."""
-        return {"advance": self.advance, "energy": self.energies}[name.removeprefix(f"{self.NAME}_")]
+        return {"advance": self.advance_by, "energy": self.energies}[name.removeprefix(f"{self.NAME}_")]
+
+    def advance_by(self, substeps: int, h: float | None = None):
+        """`substeps` steps of h (default: the scene's step)."""
+        self.advance(substeps, self.h if h is None else h)
 
     # --------------------------------------------------------------- per-system parts (Python)
-    def omega_max(self) -> float:
-        """Fastest rate in rad/s that limits the step (the stiffest mode, or a speed bound)."""
+    def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
+        """A bound (rad/s) on the fastest rate of the linearised dynamics over the whole run from these
+        initial states, damping included: the step limit is the method's limit over it (render/stability.py)."""
         raise NotImplementedError
+
+    def deviation(self, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
+        """How far apart two states are, per pendulum, in the unit of integrator.tolerance: rad on any angle."""
+        return np.abs(qa - qb).max(-1)
 
     def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
@@ -98,7 +125,7 @@ class System(runtime.Launcher):
         """Per pendulum, the angle and rate of every link, each (N, links).
 
         A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]²."""
-        p, n, links = self.scene.pendulums, self.n, len(self.LINKS)
+        p, n, links = self.scene.pendulums, self.count, len(self.LINKS)
         th = np.array([[p[f"theta{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         if p.layout == "grid":
@@ -178,12 +205,12 @@ class System(runtime.Launcher):
                     ti.atomic_min(self.bad[None], i)
 
     @ti.kernel
-    def advance(self, substeps: ti.i32):
-        """All pendulums `substeps` steps on: the state stays in registers for the whole frame."""
+    def advance(self, substeps: ti.i32, h: float):
+        """All pendulums `substeps` steps of h on: the state stays in registers for the whole frame."""
         for g in range(self.groups):
             q, v = self.gather(g)
             for _ in range(substeps):
-                q, v = integrators.step(self, q, v, self.h)
+                q, v = integrators.step(self, q, v, h)
             self.scatter(g, q, v)
 
     @ti.kernel

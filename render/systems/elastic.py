@@ -23,26 +23,24 @@ class Elastic(System):
     ERROR_UNIT = "max |Δx| of the bobs [m]"
     ACCURACY_CASE = ("elastic_fan", 1.0)
     ACCURACY_LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)
-    # From `pendulum accuracy` on elastic_fan: symplectic methods keep the energy error flat (verlet 7e-4,
-    # yoshida4 2e-6 after 1e5 steps) where RK4's creeps up. "auto" follows the spring stiffness.
-    QUALITY = {
-        "draft": {"method": "verlet", "dt": "auto", "precision": "f32"},
-        "standard": {"method": "verlet", "dt": "auto", "precision": "f64"},
-        "high": {"method": "yoshida4", "dt": "auto", "precision": "f64"},  # 6.5e-8 m at 1e-3
-        "reference": {"method": "yoshida4", "dt": 1e-4, "precision": "f64"},  # 5.7e-12 m, the reference's own
-    }
 
-    def __init__(self, scene):
+    def __init__(self, scene, *args, **kwargs):
         p = scene.pendulums
         (self.m1, self.m2), (self.l1, self.l2) = p.masses, p.lengths
         self.k1, self.k2 = p.stiffness / p.lengths[0], p.stiffness / p.lengths[1]
-        super().__init__(scene)
+        super().__init__(scene, *args, **kwargs)
 
-    def omega_max(self) -> float:
-        """Fastest linear mode of the two springs along the chain: sqrt of the top eigenvalue of M⁻¹K."""
+    def omega_max(self, q0, v0) -> float:
+        """Fastest linear mode of the two springs along the chain (sqrt of the top eigenvalue of M⁻¹K), plus the
+        damping rate, which the explicit methods meet on the real axis."""
         k1, k2, m1, m2 = self.k1, self.k2, self.m1, self.m2
         mk = np.array([[(k1 + k2) / m1, -k2 / m1], [-k2 / m2, k2 / m2]])
-        return math.sqrt(max(np.linalg.eigvals(mk).real))
+        return math.sqrt(max(np.linalg.eigvals(mk).real)) + (self.damping if self.damped else 0.0)
+
+    def deviation(self, qa, qb):
+        """The farthest bob's distance apart, as a fraction of the total rest length."""
+        gap = np.hypot(qa[..., 0::2] - qb[..., 0::2], qa[..., 1::2] - qb[..., 1::2])
+        return gap.max(-1) / (self.l1 + self.l2)
 
     def initial_state(self):
         """Bobs at their rest lengths along the fan's angles, velocities from ω1, ω2."""

@@ -1,9 +1,7 @@
 """The rigid double pendulum: Lagrange's equations for θ1'', θ2'' (angles from the downward vertical)."""
-import math
-
-import numpy as np
 import taichi as ti
 
+from .. import stability
 from ..system import System
 
 
@@ -22,32 +20,13 @@ class Rigid(System):
     ERROR_UNIT = "max |Δθ| [rad]"
     ACCURACY_CASE = ("classic", 2.0)
     ACCURACY_LADDER = (2e-2, 1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4)
-    # From `pendulum accuracy` on classic: RK4 beats implicit_midpoint at every cost (dt 1e-3: 1.8e-10 vs
-    # 5.6e-6 rad for about the same ns/step), and its energy error over 1e5 steps stays ~1e-9.
-    QUALITY = {
-        "draft": {"method": "rk4", "dt": 1 / 60, "precision": "f32"},  # one step per 60 fps frame
-        "standard": {"method": "rk4", "dt": 2e-3, "precision": "f64"},  # 2.8e-9 rad
-        "high": {"method": "rk4", "dt": 1e-3, "precision": "f64"},  # 1.8e-10 rad
-        "reference": {"method": "rk4", "dt": 2e-4, "precision": "f64"},  # 1.3e-13 rad, the reference's own
-    }
 
-    def __init__(self, scene):
+    def __init__(self, scene, *args, **kwargs):
         (self.m1, self.m2), (self.l1, self.l2) = scene.pendulums.masses, scene.pendulums.lengths
-        super().__init__(scene)
+        super().__init__(scene, *args, **kwargs)
 
-    def omega_max(self) -> float:
-        """A bound on the fastest local rate (rad/s), for choosing a stable step.
-
-        Energy bounds the speed: T = ½ωᵀM(θ)ω ≤ E with λ_min(M) ≥ det/trace, so |ω| ≤ √(2E/λ_min). Near
-        θ1 ≈ θ2 the ω² terms of θ1'' carry a factor up to ½√(m2/m1), so the local rate scales by √(1 + m2/m1):
-        a heavy lower bob whips the light upper arm (m2/m1 = 1e3 blew up RK4 at dt = 1e-3 without this).
-        """
-        p = self.scene.pendulums
-        m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.g
-        trace = (m1 + m2) * l1 ** 2 + m2 * l2 ** 2
-        lam_min = m1 * m2 * l1 ** 2 * l2 ** 2 / trace
-        energy = 2 * g * (m1 * l1 + m2 * (l1 + l2)) + 0.5 * trace * (p.omega1 ** 2 + p.omega2 ** 2)
-        return math.sqrt(1 + m2 / m1) * math.sqrt(2 * energy / lam_min)
+    def omega_max(self, q0, v0) -> float:
+        return stability.chain_rate(self.scene, q0, v0)
 
     def initial_state(self):
         return self.initial_angles()

@@ -4,10 +4,9 @@ With μ_ij the mass at or below link max(i, j), M_ij = μ_ij l_i l_j cos(θ_i �
     Σ_j M_ij θ_j'' = −Σ_j μ_ij l_i l_j sin(θ_i − θ_j) ω_j² − g μ_ii l_i sin θ_i,
 solved for θ'' by the explicit inverse of the symmetric 3×3 M (cofactors), lane by lane.
 """
-import math
-
 import taichi as ti
 
+from .. import stability
 from ..system import System
 
 
@@ -26,35 +25,17 @@ class Triple(System):
     ERROR_UNIT = "max |Δθ| [rad]"
     ACCURACY_CASE = ("triple_classic", 2.0)
     ACCURACY_LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4)
-    QUALITY = {  # the energy bound on its rates (omega_max) is 225 rad/s at unit masses: no 1/60 s draft step
-        "draft": {"method": "rk4", "dt": 5e-3, "precision": "f32"},
-        "standard": {"method": "rk4", "dt": 2e-3, "precision": "f64"},
-        "high": {"method": "rk4", "dt": 1e-3, "precision": "f64"},
-        "reference": {"method": "rk4", "dt": 2e-4, "precision": "f64"},
-    }
 
-    def __init__(self, scene):
+    def __init__(self, scene, *args, **kwargs):
         m1, m2, m3 = scene.pendulums.masses
         self.l = scene.pendulums.lengths
         # μ_ij: mass at or below link max(i, j)
         self.mu = ((m1 + m2 + m3, m2 + m3, m3), (m2 + m3, m2 + m3, m3), (m3, m3, m3))
         self.tr = sum(self.mu[i][i] * self.l[i] ** 2 for i in range(3))  # trace of M, at any angles
-        super().__init__(scene)
+        super().__init__(scene, *args, **kwargs)
 
-    def omega_max(self) -> float:
-        """A bound on the fastest local rate (rad/s), as for the double pendulum: |ω| ≤ √(2E/λ_min(M)).
-
-        λ_min ≥ det M / trace² and det M ≥ m1·m2·m3·(l1·l2·l3)² at any angles (Oppenheim's inequality: M is
-        μ∘C scaled by the lengths, μ and the cosine matrix C positive semi-definite, C with a unit diagonal).
-        The light upper links are whipped by the heavier ones below, as in the double pendulum: the factor
-        √(1 + (m2 + m3)/m1)·√(1 + m3/m2) plays the part of its √(1 + m2/m1)."""
-        p = self.scene.pendulums
-        (m1, m2, m3), (l1, l2, l3) = self.masses, self.l
-        lam_min = m1 * m2 * m3 * (l1 * l2 * l3) ** 2 / self.tr ** 2
-        energy = 2 * self.g * sum(self.mu[i][i] * self.l[i] for i in range(3)) + 0.5 * self.tr * (
-            p.omega1 ** 2 + p.omega2 ** 2 + p.omega3 ** 2)
-        whip = math.sqrt(1 + (m2 + m3) / m1) * math.sqrt(1 + m3 / m2)
-        return whip * math.sqrt(2 * energy / lam_min)
+    def omega_max(self, q0, v0) -> float:
+        return stability.chain_rate(self.scene, q0, v0)
 
     def initial_state(self):
         return self.initial_angles()
