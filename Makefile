@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 export TI_SKIP_VERSION_CHECK := ON
 
-.PHONY: demo test goldens presets accuracy bench batch clean
+.PHONY: demo test goldens presets accuracy bench batch figures clean
 
 $(BIN)/pendulum: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -33,6 +33,11 @@ bench: $(BIN)/pendulum
 
 batch: $(BIN)/pendulum
 	$(BIN)/pendulum batch
+
+# Measure, then put the figures into README.md (generated blocks) and benchmarks/figures/. Run on a quiet machine.
+figures: $(BIN)/pendulum
+	$(BIN)/pendulum accuracy
+	$(BIN)/python benchmarks/readme_figures.py
 
 clean:
 	rm -rf $(VENV) out/*/ out/index.html *.egg-info

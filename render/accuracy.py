@@ -7,7 +7,6 @@ Precision is fixed per Taichi init, so f64 and f32 run one after the other with 
 """
 from __future__ import annotations
 
-import io
 import math
 import os
 import sys
@@ -16,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import reference, registry, runtime
+from . import charts, flagship, quality, reference, registry, runtime
 from .atomic import write_atomic
 from .options import check_writable
 from .pipeline import make_system
@@ -29,7 +28,7 @@ CASES = {name: registry.get(name).ACCURACY_CASE for name in registry.names()}
 LADDER = {name: registry.get(name).ACCURACY_LADDER for name in registry.names()}
 QUICK_LADDER = (2e-3, 1e-3)
 UNITS = {name: registry.get(name).ERROR_UNIT for name in registry.names()}
-CHAOS = "rigid_chaos"  # the fan whose f32-vs-f64 divergence is charted
+CHAOS = flagship.FLAGSHIP  # the fan whose f32-vs-f64 divergence is charted
 LONG_DT, LONG_T, QUICK_LONG_T = 1e-3, 100.0, 5.0  # energy-drift run: 1e5 steps at the preset dt
 TIMING_N, QUICK_TIMING_N = 20000, 2000
 CHAOS_T, QUICK_CHAOS_T, CHAOS_FPS = 12.0, 3.0, 30
@@ -140,7 +139,8 @@ def measure(systems, arch="cpu", quick=False, show=False):
         refs[s] = reference.solve(sc, reference.initial_state(sc), horizon)[0]
     chaos_on = load(CHAOS).system in systems
     per_prec = sum(len(METHODS[s]) * len(ladder[s]) for s in systems) + 1 + chaos_on
-    step = progress(per_prec * len(PRECISIONS), show)
+    fan = len(METHODS[load(CHAOS).system]) * len(ladder.get(load(CHAOS).system, ())) if chaos_on else 0
+    step = progress(per_prec * len(PRECISIONS) + fan * len(PRECISIONS) + len(quality.LEVELS) * chaos_on, show)
     rows, energy, chaos = [], {}, {}
     for prec in ("f64", "f32"):  # f64 first: its figures are the ones the quality table leans on
         runtime.init(arch, prec)
@@ -180,7 +180,13 @@ def measure(systems, arch="cpu", quick=False, show=False):
             chaos[prec] = outer_bobs(load(CHAOS).replace(integrator={"precision": prec}),
                                      QUICK_CHAOS_T if quick else CHAOS_T)
             step(f"{CHAOS} {prec}: divergence")
-    return rows, energy, chaos
+    fan_rows = quality_rows = []
+    if chaos_on:
+        system = load(CHAOS).system
+        ns = {(r["method"], r["precision"], r["dt"]): r["ns_per_step"] for r in rows if r["system"] == system}
+        fan_rows = flagship.measure(ladder[system], ns, arch, quick, step)
+        quality_rows = flagship.quality_table(arch, quick, step)
+    return rows, energy, chaos, fan_rows, quality_rows
 
 
 # ------------------------------------------------------------------------------------------------ output
@@ -196,6 +202,24 @@ def fmt(key, val) -> str:
 
 def csv_text(rows) -> str:
     return "\n".join([",".join(COLUMNS)] + [",".join(fmt(k, r[k]) for k in COLUMNS) for r in rows]) + "\n"
+
+
+def summary_md(rows, energy) -> str:
+    """One row per system and method at the presets' dt in f64: the README's table."""
+    lines = [f"| system | method | order | error at the case's horizon | ns per pendulum-step | energy error over "
+             f"1e5 steps, first third -> last third |", "|---|---|---:|---|---:|---|"]
+    for r in rows:
+        if r["precision"] != "f64" or r["dt"] != LONG_DT:
+            continue
+        series = energy.get((r["system"], r["method"], "f64"))
+        drift = ""
+        if series is not None:
+            a = np.abs(series[1:]).max(1)
+            third = len(a) // 3
+            drift = f"{a[:third].max():.1e} -> {a[-third:].max():.1e}"
+        lines.append(f"| {r['system']} | {r['method']} | {r['order']:.2f} | {r['traj_error']:.1e} "
+                     f"{UNITS[r['system']].split('[')[-1].rstrip(']')} | {r['ns_per_step']:.0f} | {drift} |")
+    return "\n".join(lines) + "\n"
 
 
 def md_text(rows, energy, quick: bool, note: str = "") -> str:
@@ -223,80 +247,6 @@ def md_text(rows, energy, quick: bool, note: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def save_fig(fig, path: Path):
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    write_atomic(path, buf.getvalue())
-
-
-COLORS = {"symplectic_euler": "tab:red", "verlet": "tab:orange", "implicit_midpoint": "tab:purple",
-          "rk4": "tab:blue", "yoshida4": "tab:green"}
-STYLE = {"f64": "-", "f32": "--"}
-
-
-def charts(out: Path, rows, energy, chaos, systems):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    def finish(fig, ax, name, xlabel, ylabel, title, **legend):
-        ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8, **legend)
-        fig.tight_layout()
-        save_fig(fig, out / name)
-        plt.close(fig)
-
-    for s in systems:
-        preset, horizon = CASES[s]
-        fig, ax = plt.subplots(figsize=(8, 5.5))
-        for m in METHODS[s]:
-            for p in ("f64", "f32"):
-                pts = [(r["ns_per_step"] / r["dt"] / 1e3, r["traj_error"], r["dt"]) for r in rows
-                       if (r["system"], r["method"], r["precision"]) == (s, m, p) and math.isfinite(r["traj_error"])]
-                if pts:
-                    x, y, dt = map(np.array, zip(*pts))
-                    ax.loglog(x, np.maximum(y, 1e-16), STYLE[p], marker="o", ms=4, color=COLORS[m], label=f"{m} {p}")
-                    at = dt == LONG_DT
-                    ax.loglog(x[at], np.maximum(y[at], 1e-16), "o", ms=10, mfc="none", color=COLORS[m])
-        finish(fig, ax, f"work_precision_{s}.png",
-               "cost: wall time per pendulum per simulated second [µs]  (= ns per step / dt)",
-               f"trajectory error at t = {horizon:g} s, {UNITS[s]}",
-               f"Work-precision, {s} ({preset}): each curve a dt ladder, ring = dt 1e-3", ncol=2)
-
-        fig, ax = plt.subplots(figsize=(8, 5.5))
-        steps = 0
-        for (s2, m, p), series in energy.items():
-            if s2 == s:  # running max: a bounded error stays flat, a drift keeps climbing
-                ax.semilogy(np.arange(1, len(series)) / FPS, np.maximum.accumulate(np.abs(series[1:]).max(1)),
-                            STYLE[p], color=COLORS[m], label=f"{m} {p}")
-                steps = round((len(series) - 1) / FPS / LONG_DT)
-        finish(fig, ax, f"energy_drift_{s}.png", "simulated time [s]",
-               "relative energy error so far, max |E − E0| / |E0| [1]",
-               f"Energy drift, {s} ({preset}): {steps} steps of dt = {LONG_DT:g} s", ncol=2)
-    if chaos:
-        fig, ax = plt.subplots(figsize=(8, 5.5))
-        b64, b32 = chaos["f64"], chaos["f32"]
-        t = np.arange(len(b64)) / CHAOS_FPS
-        near = np.median(np.linalg.norm(np.diff(b64, axis=1), axis=-1), 1)
-        err = np.linalg.norm(b32 - b64, axis=-1)
-        ax.semilogy(t, np.sqrt(((b64 - b64.mean(1, keepdims=True)) ** 2).sum(-1).mean(1)), color="gray",
-                    label="f64: spread of the fan (RMS about its centroid)")
-        ax.semilogy(t, near, color="tab:blue", label="f64: neighbour gap (median) — what must be resolved")
-        ax.semilogy(t, np.median(np.linalg.norm(np.diff(b32, axis=1), axis=-1), 1), ":", color="tab:red",
-                    label="f32: neighbour gap (median)")
-        ax.semilogy(t, np.median(err, 1), color="black", label="f32 − f64, same pendulum (median)")
-        ax.semilogy(t, err.max(1), color="black", lw=0.7, ls="--", label="f32 − f64, same pendulum (max)")
-        lost = np.nonzero(np.median(err, 1) > near)[0]
-        if len(lost):
-            t_lost = t[lost[0]]
-            ax.axvline(t_lost, color="tab:red", lw=1)
-            ax.text(t_lost + 0.15, ax.get_ylim()[0] * 1.5, f"f32 error > neighbour gap from t = {t_lost:.1f} s",
-                    fontsize=8, color="tab:red", va="bottom")
-        finish(fig, ax, "divergence.png", "simulated time [s]", "distance between outer bobs [m]",
-               "rigid_chaos: 100 pendulums 1e-6 rad apart (rk4, dt 1e-3), f64 vs f32", loc="lower right")
-
-
 def add_parser(sub):
     p = sub.add_parser("accuracy", help="measure error vs. time of every integrator; charts and tables",
                        description="Work-precision and energy-drift charts per system, f32-vs-f64 divergence, "
@@ -314,16 +264,25 @@ def run(args) -> int:
     check_writable(args.out)
     systems = registry.names() if args.system == "all" else (args.system,)
     t0, load0 = time.perf_counter(), os.getloadavg()[0]
-    rows, energy, chaos = measure(systems, args.arch, args.quick, show=not args.no_progress)
+    rows, energy, chaos, fan_rows, quality_rows = measure(systems, args.arch, args.quick, show=not args.no_progress)
     rows.sort(key=lambda r: (systems.index(r["system"]), METHODS[r["system"]].index(r["method"]),
                              r["precision"] != "f64", -r["dt"]))
     args.out.mkdir(parents=True, exist_ok=True)
-    charts(args.out, rows, energy, chaos, systems)
+    charts.accuracy_charts(args.out, rows, energy, chaos, {s: CASES[s] for s in systems}, UNITS, FPS, LONG_DT,
+                           CHAOS_FPS)
     write_atomic(args.out / "accuracy.csv", csv_text(rows).encode())
     # Timings share the CPU with whatever else runs: say how busy it was.
     note = (f" Timed with {os.cpu_count()} CPU threads available, {args.arch}; 1-min load average "
             f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after.")
-    write_atomic(args.out / "accuracy.md", md_text(rows, energy, args.quick, note).encode())
+    md = md_text(rows, energy, args.quick, note)
+    if fan_rows:
+        scene = flagship.flagship(args.quick)
+        charts.flagship_charts(args.out, fan_rows, CHAOS, flagship.HORIZON, scene.video.duration,
+                               scene.pendulums.count)
+        md += "\n" + flagship.fan_md(fan_rows)
+        write_atomic(args.out / "quality.md", flagship.quality_md(quality_rows, args.quick).encode())
+    write_atomic(args.out / "accuracy.md", md.encode())
+    write_atomic(args.out / "summary.md", summary_md(rows, energy).encode())
     print(f"accuracy: {len(rows)} measurements in {time.perf_counter() - t0:.0f} s -> {args.out}/")
     return 0
 

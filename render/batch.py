@@ -25,7 +25,7 @@ from pathlib import Path
 from . import __version__, gallery
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
-from .options import add_common, check_writable, progress_wanted
+from .options import add_common, add_quality, check_writable, progress_wanted
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -48,8 +48,7 @@ def add_parser(sub):
     b.add_argument("--force", action="store_true", help="render again even when the output is up to date")
     b.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="render one variant per value (OUT/NAME__KEY_VALUE); repeat for a grid")
-    b.add_argument("--quality", choices=("draft", "standard", "high", "reference"),
-                   help="integrator (method, dt, precision) by accuracy level; overrides the presets'")
+    add_quality(b)
     b.add_argument("--threads", type=_positive, default=None,
                    help="Taichi CPU threads per render (default: cores / jobs locally, all cores on Dask)")
     b.add_argument("--digest", action="store_true",

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import signal
 import sys
@@ -9,7 +10,7 @@ from pathlib import Path
 
 from . import accuracy, batch, bench
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, check_writable, progress_wanted
+from .options import add_common, add_quality, check_writable, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
 MODULES = (accuracy, batch, bench)
@@ -35,8 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(r)
     r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
-    r.add_argument("--quality", choices=("draft", "standard", "high", "reference"),
-                   help="integrator (method, dt, precision) by accuracy level; overrides the preset's")
+    add_quality(r)
     r.add_argument("--threads", type=int, default=None, help="CPU threads for Taichi (default: all cores)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_render)
@@ -46,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("preset", metavar="PRESET")
     s.add_argument("--out", type=Path, required=True, metavar="FILE.npz")
     add_common(s)
+    add_quality(s)
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_simulate)
 
@@ -74,22 +75,31 @@ def summary(meta: dict, out_dir: Path) -> str:
     i, t = meta["integrator"], meta["timings_s"]
     drift = meta["energy"]["max_rel_drift"] if meta["energy"] else None
     drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
+    f, q = meta["faithfulness"], meta["quality"]
+    level = f" ({q['level']}: {'met' if q.get('met') else 'NOT met'})" if q["level"] else " (as the preset states)"
+    until = functools.partial(_until, duration=meta["duration"])
     return (f"{meta['preset']['name']}: {meta['frames']} frames {meta['width']}x{meta['height']}@{meta['fps']} | "
-            f"{i['method']} dt={i['dt']:.3g}s x{i['substeps']} {i['precision']}{drift_s} | "
+            f"{i['method']} dt={i['dt']:.3g}s x{i['substeps']} {i['precision']}{level}{drift_s} | "
+            f"faithful until {until(f['faithful_until_s'])} (median {until(f['median_until_s'])}, "
+            f"{100 * f['fraction_faithful']:.0f} % through {meta['duration']:g} s) at {f['tolerance']:g} {f['unit']} | "
             f"simulate {t['simulate']:.2f}s draw {t['draw']:.2f}s encode {t['encode']:.2f}s "
             f"total {t['total']:.2f}s -> {out_dir}/")
+
+
+def _until(t: float, duration: float) -> str:
+    return "the end" if t >= duration else f"{t:.2f} s"
 
 
 def cmd_simulate(args) -> int:
     from . import pipeline
     from .scene import load
 
-    scene = load(args.preset, args.overrides)
+    scene = load(args.preset, args.overrides, args.quality)
     if args.out.suffix != ".npz":
         raise SceneError(f"--out {args.out}: must end in .npz")
     check_writable(args.out.parent)
     info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
-    print(f"{scene.name}: {info['frames']} frames -> {args.out}")
+    print(f"{scene.name}: {info['frames']} frames, {info['line']} -> {args.out}")
     return 0
 
 

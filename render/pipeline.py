@@ -9,14 +9,25 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, registry, runtime
+from . import __version__, certify, quality, registry, runtime
 from .atomic import replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
 
 
-def make_system(scene):
+def make_system(scene, subset=None):
     """The scene's system, built by the class the registry holds for it."""
-    return registry.get(scene.system)(scene)
+    return registry.get(scene.system)(scene, subset)
+
+
+def prepare(scene, arch: str, threads: int | None):
+    """Before the first frame: the integrator a --quality level calls for, and its faithfulness certificate,
+    which refuses (SimulationError) a run that would be untrue for most of the video. Nothing is written yet."""
+    t = time.perf_counter()
+    scene, chosen = quality.choose(scene, arch, threads)
+    t_quality = time.perf_counter() - t
+    cert = certify.certify(scene, arch, threads)
+    timings = {"quality": t_quality, "certify": cert.cost_s} if scene.quality else {"certify": cert.cost_s}
+    return scene, chosen, cert, timings
 
 
 def progress_bar(total: int, desc: str, enabled: bool):
@@ -62,10 +73,11 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     from .encode import Encoder
 
     t_start = time.perf_counter()
+    scene, chosen, cert, before = prepare(scene, arch, threads)  # may refuse, before anything is written
     used = runtime.init(arch, scene.integrator.precision, threads)
-    sim = make_system(scene)  # may refuse an unstable dt (SceneError) before anything is written
+    sim = make_system(scene)
     canvas = Canvas(scene, sim)
-    timings = {"simulate": 0.0, "draw": 0.0, "encode": 0.0}
+    timings = {**before, "simulate": 0.0, "draw": 0.0, "encode": 0.0}
     with output_dir(Path(out_root) / scene.name) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video)
         try:
@@ -87,7 +99,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
-        meta = metadata(scene, sim, used, timings, sizes)
+        meta = metadata(scene, sim, used, timings, sizes, cert, chosen)
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
@@ -96,9 +108,10 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
     """Write the state at every frame time to a .npz (DESIGN.md: t, theta/omega or pos/vel, energy)."""
     if not scene.has("energy"):
         scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
+    scene, chosen, cert, before = prepare(scene, arch, None)
     runtime.init(arch, scene.integrator.precision)
     sim = make_system(scene)
-    timings = {"simulate": 0.0}
+    timings = {**before, "simulate": 0.0}
     rows: dict[str, list] = {"t": [], "energy": []}
     with progress_bar(scene.frames, scene.name, progress) as bar:
         for f in frames(scene, sim, timings):
@@ -110,10 +123,11 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
     out_file = Path(out_file)
     with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
         np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
-    return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings}
+    return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
+            "faithfulness": cert.to_dict(), "quality": chosen, "line": cert.line()}
 
 
-def metadata(scene, sim, arch: str, timings: dict, sizes: dict) -> dict:
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict) -> dict:
     import taichi as ti
     from .encode import ffmpeg_version
 
@@ -136,6 +150,8 @@ def metadata(scene, sim, arch: str, timings: dict, sizes: dict) -> dict:
         "field_bytes": sum(runtime.allocated.values()),
         "fields": dict(runtime.allocated),
         "energy": energy,
+        "faithfulness": cert.to_dict(),
+        "quality": chosen,
         "timings_s": {k: round(val, 4) for k, val in timings.items()},
         "outputs": sizes,
     }

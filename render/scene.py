@@ -16,7 +16,7 @@ from pathlib import Path
 
 from . import keys, registry
 from .errors import SceneError
-from .quality import integrator_for
+from .quality import LEVELS, check_level
 
 PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
@@ -57,6 +57,7 @@ SCHEMA: dict[str, object] = {
     "description": "",
     "system": REQUIRED,
     "effects": None,
+    "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64",
@@ -122,6 +123,7 @@ class Scene:
     pendulums: Pendulums
     integrator: Integrator
     video: Video
+    quality: str | None = None
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -131,6 +133,11 @@ class Scene:
 
     def has(self, effect: str) -> bool:
         return effect in self.effects
+
+    @property
+    def model(self) -> str:
+        """The independent model of this scene's system in render/reference.py."""
+        return registry.get(self.system).REFERENCE
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
@@ -183,11 +190,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
     except (OSError, UnicodeDecodeError) as e:
         raise SceneError(f"{src}: cannot read: {e}") from None
     raw.setdefault("name", path.stem)
-    if quality is not None and raw.get("system") in SYSTEMS:  # otherwise validation names the bad system
-        raw.setdefault("integrator", {})
-        if not isinstance(raw["integrator"], dict):
-            raise SceneError(f"{src}: integrator: must be a table")
-        raw["integrator"].update(integrator_for(quality, raw.get("system"), src))
+    if quality is not None:
+        check_level(quality, src)
+        raw["quality"] = quality
     for item in overrides:
         _apply_override(raw, item, src)
     return from_dict(raw, src)
@@ -335,7 +340,10 @@ class _Validator:
         pend = self.pendulums(d, system, video)
         integ = self.integrator(d, system)
         effects = self.effects(d, system, pend)
-        return Scene(name, d["description"], system, effects, pend, integ, video, source=self.src)
+        quality = d["quality"]
+        if quality is not None:
+            check_level(self.choice(quality, "quality", LEVELS), self.src)
+        return Scene(name, d["description"], system, effects, pend, integ, video, quality, source=self.src)
 
     def video(self, d) -> Video:
         w = self.integer(d, "video", "width", 16, 7680)

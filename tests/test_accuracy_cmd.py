@@ -11,7 +11,7 @@ from render.scene import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_precision", "energy_drift")),
-        "divergence.png")
+        "divergence.png", "work_precision_rigid_chaos.png", "faithful_rigid_chaos.png")
 
 
 def test_accuracy_quick_writes_tables_and_charts(tmp_path):
@@ -19,7 +19,8 @@ def test_accuracy_quick_writes_tables_and_charts(tmp_path):
     r = run_cli("accuracy", "--quick", "--out", out, timeout=240)
     assert r.returncode == 0, r.stderr
     assert "accuracy [" in r.stderr  # progress on stderr
-    assert sorted(p.name for p in out.iterdir()) == sorted([*PNGS, "accuracy.csv", "accuracy.md"])  # no temp files
+    assert sorted(p.name for p in out.iterdir()) == sorted([*PNGS, "accuracy.csv", "accuracy.md", "quality.md",
+                                                                  "summary.md"])
 
     with open(out / "accuracy.csv", newline="") as f:
         reader = csv.DictReader(f)
@@ -40,6 +41,10 @@ def test_accuracy_quick_writes_tables_and_charts(tmp_path):
     table = [ln for ln in md.splitlines() if ln.startswith(tuple(f"| {s} |" for s in METHODS)) and ln.count("|") == 9]
     assert len(table) == len(rows)
     assert "## Energy over" in md
+    assert "## rigid_chaos: faithful time against cost" in md
+    quality = (out / "quality.md").read_text()
+    levels = [ln.split("|")[1].strip() for ln in quality.splitlines() if ln.startswith("| ") and "---" not in ln][1:]
+    assert levels == ["draft", "standard", "high", "reference"], quality
 
     for name in PNGS:
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

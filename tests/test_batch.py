@@ -43,7 +43,7 @@ BROKEN = {
     "bad_value": dict(system="rigid", method="rk4", dt=-1.0, damping=0.0, duration=0.3),  # fails validation
     # Explicit Euler far past its stability limit: the watchdog stops it inside a worker.
     "blows_up": dict(system="elastic", method="symplectic_euler", dt=0.05, damping=0.0, duration=1.0,
-                     extra="allow_unstable = true"),
+                     extra="allow_unstable = true\nmin_faithful = 0"),  # past the faithfulness watchdog
 }
 
 
