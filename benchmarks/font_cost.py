@@ -58,6 +58,10 @@ def main():
         rows.append((f"clock, 9 glyphs -> {label}", best_us(lambda: font.draw(target, "t = 12.34 s", 20, 16))))
         rows.append((f"HUD: 3 lines (10x20) + 8 ticks (6x13), one draw_many -> {label}",
                      best_us(lambda: font.draw_many(target, hud + ticks))))
+        static = np.concatenate([font.layout(*t[:3], **(t[3] if len(t) > 3 else {})) for t in hud[1:] + ticks])
+        rows.append((f"HUD, static text laid out once, clock per frame -> {label}",
+                     best_us(lambda: font.draw_glyphs(target, np.concatenate([font.layout("t = 12.34 s", 20, 16),
+                                                                                static])))))
         rows.append((f"300 glyphs at scale 2 -> {label}", best_us(lambda: font.draw_many(target, many), calls=50)))
     n_hud = sum(len(font.layout(*h[:3], **(h[3] if len(h) > 3 else {}))) for h in hud + ticks)
     print(f"threads={args.threads or 'default'}; the HUD case draws {n_hud} glyphs")

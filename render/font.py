@@ -179,6 +179,7 @@ class Font(runtime.Launcher):
 
         (x, y) is where the text's anchor goes: ha picks the left edge, centre or right edge of each line,
         va the top, middle, baseline (of the first line) or bottom of the block. Spaces are not listed.
+        Text that does not change can be laid out once and drawn with each frame's other rows via draw_glyphs.
         """
         return np.array(self._rows(s, x, y, colour, scale, ha, va, alpha, size), np.int32).reshape(-1, COLUMNS)
 
