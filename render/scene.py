@@ -65,7 +65,7 @@ SCHEMA: dict[str, object] = {
     },
     "video": {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
-        "trail_seconds": 1.0, "gif_width": 480, "gif_fps": 25,
+        "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20,
     },
 }
 
