@@ -1,7 +1,7 @@
 """Text for the canvas: a bundled bitmap font drawn by Taichi kernels, with no system font and no Pillow.
 
 The glyphs are X.Org's misc-fixed fonts (public domain; see render/font_data.py and
-tools/make_font_data.py), in two sizes:
+benchmarks/make_font_data.py), in two sizes:
 
 - "6x13": 6×13 pixel cells (ascent 11), for small renders (256×144) and labels;
 - "10x20": 10×20 pixel cells (ascent 16), for a 720p HUD.
