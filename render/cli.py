@@ -12,7 +12,7 @@ from pathlib import Path
 from .scene import SceneError
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = ("accuracy", "batch", "bench")
+MODULES = ("accuracy", "batch", "bench", "show")
 
 
 class Terminated(BaseException):
