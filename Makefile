@@ -20,7 +20,7 @@ test: $(BIN)/pendulum
 
 # After a deliberate visual change: rewrite tests/golden/ from the current renderer, then review and commit.
 goldens: $(BIN)/pendulum
-	$(BIN)/python -m pytest tests/test_golden.py --update-goldens -q
+	$(BIN)/python -m pytest tests/test_golden.py tests/test_font.py --update-goldens -q
 
 presets: $(BIN)/pendulum
 	$(BIN)/pendulum presets

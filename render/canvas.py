@@ -84,6 +84,13 @@ class Canvas(runtime.Launcher):
             self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
         self.frame_no = 0
 
+    def restart(self):
+        """Back to the first frame: no trail yet."""
+        self.frame_no = 0
+        if self.trails:
+            self.trail.fill(0)
+            self.lit.fill(0)
+
     def new_frame(self) -> np.ndarray:
         """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
         if self.fractal:

@@ -8,12 +8,12 @@ import signal
 import sys
 from pathlib import Path
 
-from . import accuracy, batch, bench
+from . import accuracy, batch, bench, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
 from .options import add_common, add_quality, check_writable, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench)
+MODULES = (accuracy, batch, bench, show)
 
 
 class Terminated(BaseException):

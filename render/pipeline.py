@@ -66,26 +66,55 @@ def output_dir(path: Path):
         raise
 
 
+class Source:
+    """The frames of a scene, one at a time, after prepare(): what `render` encodes and `show` plays.
+
+    next_frame() returns the frame at index + 1 (frame 0 is t = 0), watchdog checked; reset() rewinds to
+    t = 0 in place, so the same frames follow again (Taichi fields are never freed: none are made anew).
+    """
+
+    def __init__(self, scene, arch: str = "cpu", threads: int | None = None):
+        from .canvas import Canvas
+
+        self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
+        self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
+        self.sim = make_system(self.scene)
+        self.canvas = Canvas(self.scene, self.sim)
+        self.name, self.frames = self.scene.name, self.scene.frames
+        self.timings = {**before, "simulate": 0.0, "draw": 0.0}
+        self.reset(rewind=False)
+
+    def reset(self, rewind: bool = True):
+        if rewind:
+            self.sim.restart()
+            self.canvas.restart()
+        self._steps = frames(self.scene, self.sim, self.timings)  # frame 0 measures the energy afresh
+        self.index = -1
+
+    def next_frame(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The next frame as H×W×3 uint8, written into `out` if given (else a new array)."""
+        self.index = next(self._steps)
+        t = time.perf_counter()
+        frame = self.canvas.draw(out)
+        self.timings["draw"] += time.perf_counter() - t
+        return frame
+
+
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
            frame_hook=None) -> dict:
     """Render scene into out_root/NAME/; returns the metadata it wrote. frame_hook(f, frame) sees raw frames."""
-    from .canvas import Canvas
     from .encode import Encoder
 
     t_start = time.perf_counter()
-    scene, chosen, cert, before = prepare(scene, arch, threads)  # may refuse, before anything is written
-    used = runtime.init(arch, scene.integrator.precision, threads)
-    sim = make_system(scene)
-    canvas = Canvas(scene, sim)
-    timings = {**before, "simulate": 0.0, "draw": 0.0, "encode": 0.0}
+    src = Source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
+    scene, timings = src.scene, src.timings
+    timings["encode"] = 0.0
     with output_dir(Path(out_root) / scene.name) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video)
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
-                for f in frames(scene, sim, timings):
-                    t = time.perf_counter()
-                    frame = canvas.draw()
-                    timings["draw"] += time.perf_counter() - t
+                for f in range(scene.frames):
+                    frame = src.next_frame()  # a new array: the encoder shares it, it does not copy
                     if frame_hook:
                         frame_hook(f, frame)
                     t = time.perf_counter()
@@ -99,7 +128,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
-        meta = metadata(scene, sim, used, timings, sizes, cert, chosen)
+        meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen)
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 

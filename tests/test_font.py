@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT
 from render import font_data, runtime
 
-GOLDEN = Path(__file__).parent / "golden" / "font" / "hud.png"
+GOLDEN = Path(__file__).parent / "golden_text" / "hud.png"  # not a preset: apart from tests/golden/
 
 # 6x13 glyphs as in the misc-fixed BDF (rows 0..12 of the cell, ascent 11)
 A_6X13 = """
