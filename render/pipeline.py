@@ -153,7 +153,13 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
     with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
         np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
-            "faithfulness": cert.to_dict(), "quality": chosen, "line": cert.line()}
+            "integrator": integrator_meta(scene, sim), "faithfulness": cert.to_dict(), "quality": chosen,
+            "line": cert.line()}
+
+
+def integrator_meta(scene, sim) -> dict:
+    return {"method": scene.integrator.method, "dt": sim.h, "dt_requested": scene.integrator.dt,
+            "substeps": sim.substeps, "precision": scene.integrator.precision}
 
 
 def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict) -> dict:
@@ -172,8 +178,7 @@ def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: di
                      "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
         "arch": arch,
         "frames": scene.frames, "fps": v.fps, "width": v.width, "height": v.height, "duration": v.duration,
-        "integrator": {"method": scene.integrator.method, "dt": sim.h, "dt_requested": scene.integrator.dt,
-                       "substeps": sim.substeps, "precision": scene.integrator.precision},
+        "integrator": integrator_meta(scene, sim),
         "effects": list(scene.effects),
         "kernels": list(runtime.launched),
         "field_bytes": sum(runtime.allocated.values()),

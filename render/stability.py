@@ -1,7 +1,8 @@
 """The step limit: a bound on the fastest rate of the linearised dynamics over every state the run can reach.
 
-A conservative system keeps its energy (damping only lowers it), so every state of the run lies in the set
-{E(q, v) ≤ E_max}, E_max the largest initial energy of the scene. For a chain of rigid links this bound is
+A conservative system keeps its energy (damping only lowers it), and the energy watchdog stops a run whose
+energy drifts by more than integrator.max_drift, so every state of the run lies in the set
+{E(q, v) ≤ E_max·(1 + max_drift)}, E_max the largest initial energy of the scene. For a chain of rigid links this bound is
 the largest spectral radius of the Jacobian of (θ, ω) ↦ (ω, θ'') over that set, damping included (its −c
 on the real axis is what limits the explicit methods there). It is found by sampling: angles everywhere
 (random, plus every aligned and folded configuration), and velocities on the energy shell along random
@@ -16,6 +17,7 @@ import math
 import numpy as np
 
 from . import reference
+from .system import DEFAULT_MAX_DRIFT
 
 MARGIN = 1.25  # over the largest sampled radius: covers what falls between the samples
 SAMPLES = 1024  # random configurations
@@ -26,7 +28,7 @@ def chain_rate(scene, q0: np.ndarray, v0: np.ndarray) -> float:
     """Bound (rad/s) on |eigenvalues| of the linearised chain over every state with E ≤ max E(q0, v0)."""
     p = reference.params(scene)
     n = len(p.lengths)
-    e_max = float(np.max(reference.energy(scene, q0, v0)))
+    e_max = float(np.max(reference.energy(scene, q0, v0))) * (1 + (scene.integrator.max_drift or DEFAULT_MAX_DRIFT))
     rng = np.random.default_rng(0)  # the same bound for the same scene, every run
     corners = np.array(list(itertools.product((0.0, math.pi), repeat=n)))
     th = np.concatenate([corners, rng.uniform(-math.pi, math.pi, (SAMPLES, n))])
