@@ -15,7 +15,9 @@ class Elastic(System):
     DOC = "two springs of rest lengths `lengths`, k = stiffness / rest length (Newton in x, y)"
     D = 4  # q = (x1, y1, x2, y2) with the pivot at the origin, v likewise
     LINKS = ("spring", "spring")
-    KEYS = {"stiffness": Real(2e3, 0.0, 1e12, lo_open=True)}  # Young's-modulus-like E, as in the seed
+    # Young's-modulus-like E, as in the seed. Within [1e-6, 1e12]: the spring constants k = E/l this gives
+    # with lengths in [1e-6, 1e6] stay finite in f32; how fast a stiff spring makes the step is budget.py's.
+    KEYS = {"stiffness": Real(2e3, 1e-6, 1e12)}
     METHODS = ("symplectic_euler", "rk4", "verlet", "yoshida4")
     DEFAULT_EFFECTS = ("springs", "bobs", "trails", "energy")
     STATE = {"pos": ("q", (2, 2)), "vel": ("v", (2, 2))}
