@@ -13,7 +13,7 @@ contract (LINKS, bob_sizes(), reach(), lengths).
 import numpy as np
 import taichi as ti
 
-from . import integrators, keys, runtime
+from . import budget, integrators, keys, runtime
 from .errors import SimulationError
 
 DEFAULT_MAX_DRIFT = 0.05
@@ -55,6 +55,7 @@ class System(runtime.Launcher):
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
         self.h, self.substeps = integrators.timestep(scene, self.omega_max())
+        budget.check_steps(scene, self.substeps, self.h)  # "auto" is known only now: refuse before any work
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
         self.groups = -(-self.n // self.LANES)
         real = runtime.real()
