@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, registry, runtime
-from .atomic import replacing, write_atomic
+from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
 
 
@@ -87,7 +87,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
-        meta = metadata(scene, sim, used, timings, sizes)
+        meta = metadata(scene, sim, used, timings, sizes, {f: digest(out_dir / f) for f in sizes})
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
@@ -113,7 +113,7 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings}
 
 
-def metadata(scene, sim, arch: str, timings: dict, sizes: dict) -> dict:
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict, sha256: dict | None = None) -> dict:
     import taichi as ti
     from .encode import ffmpeg_version
 
@@ -138,4 +138,5 @@ def metadata(scene, sim, arch: str, timings: dict, sizes: dict) -> dict:
         "energy": energy,
         "timings_s": {k: round(val, 4) for k, val in timings.items()},
         "outputs": sizes,
+        "outputs_sha256": sha256 or {},  # file name -> sha256: `batch` re-renders a file changed in place
     }
