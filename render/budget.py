@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -152,7 +153,7 @@ def num(x: int) -> str:
     """A count for a message: 2.45e11, or every digit where rounding would make it read as the limit."""
     if x < 1e6:
         return str(x)
-    short = f"{x:.3g}".replace("e+", "e")
+    short = re.sub(r"e\+0*", "e", f"{x:.3g}")  # 3.79e+08 -> 3.79e8
     return short if float(short) != STEP_LIMIT or x == STEP_LIMIT else f"{x:,}"
 
 
