@@ -24,7 +24,8 @@ def add_common(p):
 def positive_int(text: str, most: int | None = None) -> int:
     """An argparse type: an integer >= 1 (and <= most); anything else is a usage error (exit 2)."""
     text = text.strip()
-    if not (text.isascii() and text.isdigit()) or len(text) > 9 or int(text) < 1 or (most is not None and int(text) > most):
+    digits = text.isascii() and text.isdigit() and len(text) <= 18  # int() of thousands of digits is refused
+    if not digits or int(text) < 1 or (most is not None and int(text) > most):
         limit = f" up to {most}" if most is not None else ""
         raise argparse.ArgumentTypeError(f"must be a positive integer{limit}, got {text[:40]!r}")
     return int(text)
