@@ -118,7 +118,9 @@ def cmd_simulate(args) -> int:
     try:
         info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
     except OSError as e:  # e.g. a full disk while writing: numpy's error does not say which file
-        raise OSError(e.errno, e.strerror, str(args.out)) from e
+        if e.filename is None and e.strerror:
+            raise OSError(e.errno, e.strerror, str(args.out)) from e
+        raise
     print(f"{scene.name}: {info['frames']} frames -> {args.out}")
     return 0
 
@@ -171,8 +173,8 @@ def main(argv=None) -> int:
 
 def fail(code: int, kind: str, error, debug: bool) -> int:
     """Report an error as one line on stderr (with the traceback first under --debug); return the code."""
-    if debug and isinstance(sys.exc_info()[1], BaseException):
-        traceback.print_exc()
+    if debug:
+        traceback.print_exc()  # called from an except block: the exception being handled
     print(f"pendulum: {kind}: {one_line(str(error))}", file=sys.stderr)
     return code
 

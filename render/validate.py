@@ -140,9 +140,9 @@ class Validator:
         system = self.choice(d["system"], "system", SYSTEMS)
         video = self.video(d)
         pend = self.pendulums(d, system, video)
+        integ = self.integrator(d, system)
         return {"name": name, "description": description, "system": system,
-                "effects": self.effects(d, system, pend), "pendulums": pend,
-                "integrator": self.integrator(d, system), "video": video}
+                "effects": self.effects(d, system, pend), "pendulums": pend, "integrator": integ, "video": video}
 
     def video(self, d) -> dict:
         w = self.integer(d, "video", "width", 16, 7680)
