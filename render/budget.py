@@ -77,7 +77,8 @@ def check_steps(scene, substeps: int, h: float) -> None:
     usual = frames * max(1, math.ceil(1.0 / (scene.video.fps * AUTO_DT))) * n  # the same scene at dt = 1e-3
     if dt == "auto" and usual <= STEP_LIMIT:
         raise SceneError(f"{scene.source}: integrator.dt: \"auto\" needs steps of {h:.3g} s for this scene's "
-                         f"fastest rate, and {what}; stiff springs or tiny light bobs are the usual cause")
+                         f"fastest rate, and {what}; stiff springs, or light bobs under heavy ones or on tiny "
+                         f"links, are the usual cause")
     if dt != "auto" and (usual <= STEP_LIMIT or substeps > SUBSTEP_LIMIT):
         raise SceneError(f"{scene.source}: integrator.dt: dt too small: {what}; use a larger integrator.dt")
     raise SceneError(f"{scene.source}: pendulums.count, video.duration: {what}; use fewer pendulums, "

@@ -29,10 +29,11 @@ class Reals:
 
 # Ranges of a chain's keys: where f64 (and f32) arithmetic on them stays meaningful. Angles wrap, so
 # beyond ±1000 rad a value only loses resolution (f64 resolves ~1e-13 rad there, f32 ~1e-4). A link turning
-# at 1e4 rad/s (1600 turns a second, 27 per 60 fps frame) is no longer a picture, and ω² then stays far
-# from overflow in f32. Lengths (m) and masses (kg) within [1e-6, 1e6]: twelve decades, and the products
-# the equations form (m·l²·ω², g·m·l) stay within f32's range; what a tiny or stiff scene costs in steps
-# is the step budget's to refuse (render/budget.py), not a range's.
+# at 1e4 rad/s (1600 turns a second, 27 per 60 fps frame) is no longer a picture. Lengths (m) and masses
+# (kg) within [1e-6, 1e6]: twelve decades, and the products the equations form (m·l²·ω², g·m·l, the
+# triple's determinant ~ (m·l²)³) stay far inside f64's range (f32 drafts are held to [1e-3, 1e3] by
+# render/validate.py); what a tiny or stiff scene costs in steps is the step budget's to refuse
+# (render/budget.py), not a range's.
 ANGLE_MAX = 1e3
 RATE_MAX = 1e4
 SIZE_MIN, SIZE_MAX = 1e-6, 1e6

@@ -36,6 +36,10 @@ DESCRIPTION_MAX = 1000  # free text shown in the gallery; longer is almost surel
 SPREAD_MAX = 1e3
 GRAVITY_MAX = 1e4
 DAMPING_MAX = 1e3
+# f32 (drafts) spans 1e-38..3e38: the triple pendulum's mass-matrix determinant grows like (m·l²)³, so
+# lengths and masses of 1e6 overflow it and 1e-6 underflow it (NaN at the first frame). Within [1e-3, 1e3]
+# every system's f32 arithmetic stays in range.
+F32_SIZE_MIN, F32_SIZE_MAX = 1e-3, 1e3
 
 REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
 
@@ -141,6 +145,12 @@ class Validator:
         video = self.video(d)
         pend = self.pendulums(d, system, video)
         integ = self.integrator(d, system)
+        if integ["precision"] == "f32":
+            for key in ("lengths", "masses"):
+                for i, x in enumerate(pend[key]):
+                    if not F32_SIZE_MIN <= x <= F32_SIZE_MAX:
+                        self.fail(f"pendulums.{key}[{i}]", f"{x:g} is beyond what f32 arithmetic holds here (within "
+                                  f"[{F32_SIZE_MIN:g}, {F32_SIZE_MAX:g}]); use integrator.precision = \"f64\"")
         return {"name": name, "description": description, "system": system,
                 "effects": self.effects(d, system, pend), "pendulums": pend, "integrator": integ, "video": video}
 

@@ -32,7 +32,8 @@ BASE = {"system": SYSTEMS[0], "pendulums": {"count": 2, "theta1": 2.0, "theta2":
 KEYS = ([("name",), ("description",), ("system",), ("effects",)]
         + [(sec, k) for sec, table in SCHEMA.items() if isinstance(table, dict) for k in table]
         + [("pendulums", "bogus"), ("video", "colour"), ("integrator",), ("video",), ("extra",)])
-CHOICES = sorted({*EFFECTS, *FORMATS, *LAYOUTS, *PRECISIONS, *SYSTEMS, "auto", *(m for ms in METHODS.values() for m in ms)})
+CHOICES = sorted({*EFFECTS, *FORMATS, *LAYOUTS, *PRECISIONS, *SYSTEMS, "auto",
+                  *(m for ms in METHODS.values() for m in ms)})
 EDGES = [0, -1, 1, 2, 16, 0.0, -0.0, 1e-300, 5e-324, 1e-12, 1e-6, 1e6, 1e12, 1e308, 2 ** 31, 2 ** 63, 10 ** 400,
          4_000_001, 7680, math.inf, -math.inf, math.nan]
 
