@@ -227,6 +227,7 @@ def test_an_unexpected_error_is_one_line_and_debug_shows_the_traceback(tmp_path)
     r = run_cli(*args, cwd=tmp_path, timeout=60, preexec_fn=tight)
     line = one_line(r, 1, "unexpected error", "--debug")
     assert nothing_in(tmp_path / "out")
-    for extra, env in ((["--debug"], None), ([], {**os.environ, "PENDULUM_DEBUG": "1"})):
-        r = run_cli(*extra, *args, cwd=tmp_path, timeout=60, preexec_fn=tight, env=env)
+    for argv, env in ((["--debug", *args], None), ([*args, "--debug"], None),
+                      (args, {**os.environ, "PENDULUM_DEBUG": "1"})):
+        r = run_cli(*argv, cwd=tmp_path, timeout=60, preexec_fn=tight, env=env)
         assert r.returncode == 1 and "Traceback" in r.stderr and r.stderr.strip().splitlines()[-1] == line
