@@ -42,11 +42,6 @@ GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 un
 def check(scene, system, out: Path, simulate: bool = False) -> None:
     """Refuse `scene` if its steps, memory or output exceed the limits. `system` is its System class (for
     the size of its state); `out` is where the output goes (a folder, or the .npz's folder)."""
-    # A pinned dt gives its substeps now; "auto" at least those of AUTO_DT (stiffness only adds more), as
-    # integrators.timestep rounds them. The System checks again with the step it settles on.
-    dt = AUTO_DT if scene.integrator.dt == "auto" else scene.integrator.dt
-    ratio = 1.0 / (scene.video.fps * dt)  # inf for a subnormal dt
-    substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
     src = scene.source
     need, key, detail = memory(scene, system, simulate)
     limit, total = memory_limit()
@@ -59,6 +54,11 @@ def check(scene, system, out: Path, simulate: bool = False) -> None:
     if need > free:
         raise SceneError(f"{src}: {key}: the output needs about {size(need)} of disk ({detail}), "
                          f"{size(free)} free in {where}")
+    # A pinned dt gives its substeps now; "auto" at least those of AUTO_DT (stiffness only adds more), as
+    # integrators.timestep rounds them. The System checks again with the step it settles on.
+    dt = AUTO_DT if scene.integrator.dt == "auto" else scene.integrator.dt
+    ratio = 1.0 / (scene.video.fps * dt)  # inf for a subnormal dt
+    substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
     check_steps(scene, substeps, 1.0 / (scene.video.fps * substeps))
 
 
