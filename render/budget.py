@@ -57,7 +57,10 @@ def check(scene, system, out: Path, simulate: bool = False) -> None:
     # A pinned dt gives its substeps now; "auto" at least those of AUTO_DT (stiffness only adds more), as
     # integrators.timestep rounds them. The System checks again with the step it settles on.
     dt = AUTO_DT if scene.integrator.dt == "auto" else scene.integrator.dt
-    ratio = 1.0 / (scene.video.fps * dt)  # inf for a subnormal dt
+    # A subnormal dt gives fps·dt = 0 once Taichi has started (its CPU runtime sets the FPU's denormal
+    # flags for the whole process), or 1/(fps·dt) = inf before: either way, more substeps than anything holds.
+    per_frame = scene.video.fps * dt
+    ratio = 1.0 / per_frame if per_frame > 0 else math.inf
     substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
     check_steps(scene, substeps, 1.0 / (scene.video.fps * substeps))
 
