@@ -75,6 +75,9 @@ def cmd_render(args) -> int:
     scenes = distinct(scenes, args.out)
     check_writable(args.out)
     for scene in scenes:
+        if (args.out / scene.name).exists() and not (args.out / scene.name).is_dir():
+            raise SceneError(f"--out {args.out}: {args.out / scene.name} is a file; {scene.name} renders into a "
+                             f"folder of that name")
         budget.check(scene, registry.get(scene.system), args.out)
     for scene in scenes:
         meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),

@@ -127,6 +127,15 @@ def test_two_presets_with_the_same_name_are_refused_naming_both(tmp_path):
     assert nothing_in(tmp_path / "out")
 
 
+def test_a_file_where_the_render_folder_goes_is_refused(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "classic").write_text("mine")
+    r = run_user("render", "classic", "--out", "out", *TINY, cwd=tmp_path)
+    one_line(r, 2, "--out", "classic is a file")
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["classic"]
+    assert (tmp_path / "out" / "classic").read_text() == "mine"
+
+
 # ------------------------------------------------------------------ runs, or fails cleanly while running
 
 
