@@ -1,16 +1,71 @@
-"""Files appear whole or not at all: write beside the target, rename onto it only on success."""
+"""Files appear whole or not at all: write beside the target, rename onto it only on success.
+
+A temporary file is hidden and names its owner: .NAME.<host>-<pid>.<random>.part, where <host> is a short
+hash of the host name. A process killed with SIGKILL cannot remove its temporaries, so whoever next writes
+into that folder sweeps the ones whose owner is gone (sweep_stale): on this host, a process that no longer
+exists; from another host sharing the folder (a Dask cluster), where liveness cannot be seen from here,
+only after FOREIGN_STALE_S without a write. A live writer's file is never touched.
+"""
+import hashlib
 import os
+import re
+import socket
 import tempfile
+import time
+import zlib
 from contextlib import contextmanager
 from pathlib import Path
 
+FOREIGN_STALE_S = 7 * 24 * 3600  # a week: far longer than any render the step budget lets start
+HOST = f"{zlib.crc32(socket.gethostname().encode()):08x}"
+_OWNED = re.compile(r"\..+\.([0-9a-f]{8})-(\d+)\.[a-z0-9_]+\.[A-Za-z0-9]+")  # what temp_beside creates
+
 
 def temp_beside(path: Path, suffix: str = ".part") -> Path:
-    """A new, empty, hidden file in the same directory as `path` (so the final rename is atomic)."""
+    """A new, empty, hidden file in the same directory as `path` (so the final rename is atomic); stale
+    temporaries of dead writers in that directory are swept first."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    sweep_stale(path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{HOST}-{os.getpid()}.", suffix=suffix, dir=path.parent)
     os.close(fd)
     return Path(tmp)
+
+
+def sweep_stale(folder: Path) -> list[Path]:
+    """Remove the temporaries in `folder` whose writer is gone; returns what was removed."""
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed  # a folder not there yet holds nothing to sweep
+    for entry in entries:
+        m = _OWNED.fullmatch(entry.name)
+        if not m or not entry.is_file(follow_symlinks=False):
+            continue
+        host, pid = m.group(1), int(m.group(2))
+        try:
+            if host == HOST:
+                stale = not _alive(pid)
+            else:
+                stale = time.time() - entry.stat(follow_symlinks=False).st_mtime > FOREIGN_STALE_S
+            if stale:
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:
+            pass  # gone already (another sweeper), or not ours to remove: leave it
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)  # signal 0: only asks whether the process exists
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True  # exists, owned by someone else (or a pid no process can have: be careful, keep it)
+    return True
 
 
 def publish(tmp: Path, path: Path):
@@ -34,3 +89,12 @@ def replacing(path: Path, suffix: str = ".part"):
 def write_atomic(path: Path, data: bytes | str):
     with replacing(path) as tmp:
         tmp.write_bytes(data.encode() if isinstance(data, str) else data)
+
+
+def digest(path: Path) -> str:
+    """sha256 of a file's bytes, read in chunks (outputs can be large)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()

@@ -7,7 +7,6 @@ exceptions. A summary table goes to stdout, out/batch.json records the rows and 
 """
 from __future__ import annotations
 
-import argparse
 import difflib
 import fnmatch
 import glob
@@ -22,10 +21,10 @@ import threading
 import time
 from pathlib import Path
 
-from . import __version__, gallery
+from . import __version__, budget, gallery, registry
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
-from .options import add_common, add_quality, check_writable, progress_wanted
+from .options import add_common, add_quality, check_writable, positive_int, progress_wanted, thread_count
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -40,7 +39,7 @@ def add_parser(sub):
                    help="preset names, .toml paths or globs of either (default: every file in presets/)")
     add_common(b)
     b.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
-    b.add_argument("--jobs", "-j", type=_positive, default=None, metavar="J",
+    b.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="J",
                    help="local worker processes (default: the number of cores)")
     b.add_argument("--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
                    help="run on this Dask scheduler, e.g. tcp://host:8786 (default: $DASK_SCHEDULER_ADDRESS); "
@@ -49,18 +48,12 @@ def add_parser(sub):
     b.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="render one variant per value (OUT/NAME__KEY_VALUE); repeat for a grid")
     add_quality(b)
-    b.add_argument("--threads", type=_positive, default=None,
+    b.add_argument("--threads", type=thread_count, default=None,
                    help="Taichi CPU threads per render (default: cores / jobs locally, all cores on Dask)")
     b.add_argument("--digest", action="store_true",
                    help="record a sha256 of each render's raw frames in OUT/batch.json (reproducibility checks)")
     b.add_argument("--no-progress", action="store_true", help="no per-preset progress lines on stderr")
     b.set_defaults(func=run)
-
-
-def _positive(text: str) -> int:
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}")
-    return int(text)
 
 
 # ---------------------------------------------------------------- planning (parent process)
@@ -237,8 +230,12 @@ def scheduler_address(text: str | None) -> str | None:
     if not text:
         return None
     address = text if "://" in text else f"tcp://{text}"
-    if not re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://[^\s/]+", address):
-        raise SceneError(f"--scheduler {text}: expected an address like tcp://host:8786")
+    # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
+    # raise in a background thread and hang)
+    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
+    port = m and m.group(3)
+    if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
+        raise SceneError(f"--scheduler {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
     return address
 
 
@@ -247,7 +244,7 @@ def run_dask(scenes, out_root, address, arch, threads, digest):
     from dask.distributed import Client, as_completed
     try:
         client = Client(address, timeout="10s", set_as_default=False)
-    except (OSError, TimeoutError) as e:
+    except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...), no batch
         raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
     futs = {}
     try:
@@ -278,6 +275,11 @@ def run(args) -> int:
     rows: dict[str, dict] = {}
     todo = []
     for job in jobs_plan:
+        if "scene" in job:
+            try:  # what each render costs, refused before any work as a bad preset is
+                budget.check(job["scene"], registry.get(job["scene"].system), out_root)
+            except SceneError as e:
+                job["error"] = str(e)
         if "error" in job:
             rows[job["name"]] = {"preset": job["name"], "status": "failed", "error": job["error"]}
         elif not args.force and (meta := gallery.up_to_date(job["scene"], out_root)):

@@ -1,4 +1,9 @@
-"""The `pendulum` command. Exit codes: 0 ok, 1 failure while running, 2 bad input, 130/143 interrupted."""
+"""The `pendulum` command. Exit codes: 0 ok, 1 failure while running, 2 bad input, 130/143 interrupted.
+
+Whatever goes wrong, the user reads one line on stderr, never a traceback: bad input is exit 2, a failure
+while running (the watchdog, ffmpeg, a full disk, or an error nobody foresaw) exit 1. `--debug` or
+PENDULUM_DEBUG=1 prints the traceback as well.
+"""
 from __future__ import annotations
 
 import argparse
@@ -6,11 +11,12 @@ import functools
 import os
 import signal
 import sys
+import traceback
 from pathlib import Path
 
 from . import accuracy, batch, bench, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, add_quality, check_writable, progress_wanted
+from .options import add_common, add_quality, check_writable, progress_wanted, thread_count
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
 MODULES = (accuracy, batch, bench, show)
@@ -22,12 +28,14 @@ class Terminated(BaseException):
 
 class Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2 (argparse prints usage too by default)
-        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
     p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
                epilog="Presets live in presets/*.toml; see README.md for the format.")
+    p.add_argument("--debug", action="store_true", help="on an error, print the traceback too "
+                   "(or set PENDULUM_DEBUG=1)")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     r = sub.add_parser("render", help="render presets to out/NAME/ (MP4, GIF, metadata.json)",
@@ -37,7 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_common(r)
     r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
     add_quality(r)
-    r.add_argument("--threads", type=int, default=None, help="CPU threads for Taichi (default: all cores)")
+    r.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_render)
 
@@ -55,20 +63,39 @@ def build_parser() -> argparse.ArgumentParser:
 
     for module in MODULES:
         module.add_parser(sub)
+    for command in sub.choices.values():  # --debug also after the command; main() reads it from argv
+        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     return p
 
 
 def cmd_render(args) -> int:
-    from . import pipeline
+    from . import budget, pipeline, registry
     from .scene import load
 
     scenes = [load(p, args.overrides, args.quality) for p in args.presets]  # all validated before any work
+    scenes = distinct(scenes, args.out)
     check_writable(args.out)
+    for scene in scenes:
+        if (args.out / scene.name).exists() and not (args.out / scene.name).is_dir():
+            raise SceneError(f"--out {args.out}: {args.out / scene.name} is a file; {scene.name} renders into a "
+                             f"folder of that name")
+        budget.check(scene, registry.get(scene.system), args.out)
     for scene in scenes:
         meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),
                                threads=args.threads)
         print(summary(meta, args.out / scene.name))
     return 0
+
+
+def distinct(scenes: list, out: Path) -> list:
+    """The scenes once each; two files with the same name would overwrite one render with the other."""
+    seen = {}
+    for scene in scenes:
+        other = seen.setdefault(scene.name, scene)
+        if other.source != scene.source:
+            raise SceneError(f"{other.source} and {scene.source}: name: both are {scene.name!r}, so both would "
+                             f"render to {out / scene.name}/; rename one (name = \"...\")")
+    return list(seen.values())
 
 
 def summary(meta: dict, out_dir: Path) -> str:
@@ -91,14 +118,22 @@ def _until(t: float, duration: float) -> str:
 
 
 def cmd_simulate(args) -> int:
-    from . import pipeline
+    from . import budget, pipeline, registry
     from .scene import load
 
     scene = load(args.preset, args.overrides, args.quality)
     if args.out.suffix != ".npz":
         raise SceneError(f"--out {args.out}: must end in .npz")
+    if args.out.is_dir():
+        raise SceneError(f"--out {args.out}: is a directory; give the file to write, e.g. {args.out / scene.name}.npz")
     check_writable(args.out.parent)
-    info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
+    budget.check(scene, registry.get(scene.system), args.out.parent, simulate=True)
+    try:
+        info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
+    except OSError as e:  # e.g. a full disk while writing: numpy's error does not say which file
+        if e.filename is None and e.strerror:
+            raise OSError(e.errno, e.strerror, str(args.out)) from e
+        raise
     print(f"{scene.name}: {info['frames']} frames, {info['line']} -> {args.out}")
     return 0
 
@@ -120,15 +155,16 @@ def main(argv=None) -> int:
         raise Terminated()
 
     signal.signal(signal.SIGTERM, on_term)
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    # read before parsing, so that even an error while parsing can show its traceback
+    debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")
     try:
         args = build_parser().parse_args(argv)
         return args.func(args)
     except SceneError as e:
-        print(f"pendulum: error: {e}", file=sys.stderr)
-        return 2
+        return fail(2, "error", e, debug)
     except (SimulationError, EncodeError, BatchError) as e:
-        print(f"pendulum: failed: {e}", file=sys.stderr)
-        return 1
+        return fail(1, "failed", e, debug)
     except KeyboardInterrupt:
         print("pendulum: interrupted; no partial output was left", file=sys.stderr)
         return 130
@@ -138,3 +174,26 @@ def main(argv=None) -> int:
     except Terminated:
         print("pendulum: terminated; no partial output was left", file=sys.stderr)
         return 143
+    except OSError as e:  # the file system while running: a full disk, a vanished folder, permissions
+        where = f": {e.filename}" if e.filename else ""
+        return fail(1, "failed", f"{e.strerror or e}{where}", debug)
+    except MemoryError as e:
+        return fail(1, "failed", f"out of memory ({e or 'MemoryError'})", debug)
+    except Exception as e:  # noqa: BLE001 - a bug or an unforeseen fault: still one line, not a traceback
+        why = f"{type(e).__name__}: {e}".rstrip(": ")
+        return fail(1, "unexpected error", f"{why} (run with --debug for the traceback)", debug)
+
+
+def fail(code: int, kind: str, error, debug: bool) -> int:
+    """Report an error as one line on stderr (with the traceback first under --debug); return the code."""
+    if debug:
+        traceback.print_exc()  # called from an except block: the exception being handled
+    print(f"pendulum: {kind}: {one_line(str(error))}", file=sys.stderr)
+    return code
+
+
+def one_line(text: str, limit: int = 2000) -> str:
+    """A message as one printable line: control characters escaped (file names and values may hold
+    newlines), and an overlong message cut."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text.strip())
+    return text if len(text) <= limit else text[:limit - 3] + "..."

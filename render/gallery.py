@@ -14,7 +14,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 from . import __version__
-from .atomic import write_atomic
+from .atomic import digest, write_atomic
 
 CSS = """
 body{font:14px/1.4 system-ui,sans-serif;margin:2em;background:#111;color:#ddd}
@@ -64,17 +64,20 @@ def write_index(out_root: Path, failed: list[tuple[str, str]] = ()) -> Path:
 
 
 def up_to_date(scene, out_root: Path) -> dict | None:
-    """The existing metadata when out_root/NAME holds this scene's render by this version, files intact."""
+    """The existing metadata when out_root/NAME holds this scene's render by this version, files intact:
+    each output's size and sha256 as metadata.json records them (a render without hashes is redone)."""
     d = Path(out_root) / scene.name
     try:
         meta = json.loads((d / "metadata.json").read_text())
         if meta["preset_hash"] != scene.hash() or meta["versions"]["package"] != __version__:
             return None
-        outputs = meta["outputs"]
-        if not {f"{scene.name}.{fmt}" for fmt in scene.video.formats} <= set(outputs):
+        outputs, sums = meta["outputs"], meta["outputs_sha256"]
+        if not {f"{scene.name}.{fmt}" for fmt in scene.video.formats} <= set(outputs) or set(sums) != set(outputs):
             return None
         if any(not (d / f).is_file() or (d / f).stat().st_size != size for f, size in outputs.items()):
-            return None
+            return None  # the cheap test first: a file gone or resized
+        if any(digest(d / f) != sums[f] for f in outputs):
+            return None  # changed in place (same size): only its content hash tells
         return meta
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return None

@@ -24,18 +24,33 @@ YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
 YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
 
 
+def step_limit(scene, omega_max: float) -> float:
+    """The longest stable step of the scene's method: its limit over the rate, damping added.
+
+    Viscous damping c adds a decaying mode of rate c, which limits explicit methods on the real axis as an
+    oscillation of rate ω does on the imaginary one; adding the two is a simple, safe bound."""
+    damping = scene.pendulums.damping if scene.has("damping") else 0.0
+    rate = omega_max + damping
+    if not math.isfinite(rate):
+        raise SceneError(f"{scene.source}: pendulums: the scene's fastest rate is not finite (omega_max = "
+                         f"{omega_max}): its values are beyond what f64 arithmetic can step")
+    return STABILITY[scene.integrator.method] / rate if rate > 0 else math.inf  # at rest without gravity
+
+
 def timestep(scene, omega_max: float) -> tuple[float, int]:
     """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
     frame_dt = 1.0 / scene.video.fps
     method, dt = scene.integrator.method, scene.integrator.dt
-    limit = STABILITY[method] / omega_max
+    limit = step_limit(scene, omega_max)
     if dt == "auto":
         dt = min(AUTO_DT, SAFETY * limit)
     elif dt > limit and not scene.integrator.allow_unstable:
+        damping = scene.pendulums.damping if scene.has("damping") else 0.0
+        with_damping = f" + damping {damping:g} 1/s" if damping else ""
         raise SceneError(
             f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
-            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s, so "
-            f"dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
+            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s{with_damping}, "
+            f"so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
             f"or set integrator.allow_unstable = true to proceed anyway")
     substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
     return frame_dt / substeps, substeps

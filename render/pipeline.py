@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, certify, quality, registry, runtime
-from .atomic import replacing, write_atomic
+from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
 
 
@@ -128,7 +128,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
-        meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen)
+        meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen,
+                        {f: digest(out_dir / f) for f in sizes})
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
@@ -162,7 +163,8 @@ def integrator_meta(scene, sim) -> dict:
             "substeps": sim.substeps, "precision": scene.integrator.precision}
 
 
-def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict) -> dict:
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict,
+             sha256: dict | None = None) -> dict:
     import taichi as ti
     from .encode import ffmpeg_version
 
@@ -188,4 +190,5 @@ def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: di
         "quality": chosen,
         "timings_s": {k: round(val, 4) for k, val in timings.items()},
         "outputs": sizes,
+        "outputs_sha256": sha256 or {},  # file name -> sha256: `batch` re-renders a file changed in place
     }

@@ -44,8 +44,10 @@ def cost(s: dict, fps: int) -> float:
 def candidates(scene, rate: float) -> list[dict]:
     """Every stable (method, dt, precision) the system offers, cheapest first."""
     frame = 1.0 / scene.video.fps
-    out = [setting(m, dt, p) for m in registry.get(scene.system).METHODS for p in ("f32", "f64")
-           for dt in (frame, *(d for d in LADDER if d < frame)) if dt * rate < integrators.STABILITY[m]]
+    limit = {m: integrators.step_limit(_with(scene, setting(m, frame, "f64")), rate)
+             for m in registry.get(scene.system).METHODS}
+    out = [setting(m, dt, p) for m in limit for p in ("f32", "f64")
+           for dt in (frame, *(d for d in LADDER if d < frame)) if dt < limit[m]]
     return sorted(out, key=lambda s: (cost(s, scene.video.fps), s["precision"] == "f32"))
 
 

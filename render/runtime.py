@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import sys
+import tempfile
 import warnings
 
 import taichi as ti
@@ -32,7 +34,7 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) 
         kw["cpu_max_num_threads"] = threads
     # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
     # ti.init prints "[Taichi] Starting on arch=..." to stdout unconditionally; stdout is for results.
-    with contextlib.redirect_stdout(io.StringIO()):
+    with contextlib.redirect_stdout(io.StringIO()), _stderr_held():
         ti.init(arch=ti.cuda if arch == "cuda" else ti.cpu, **kw)
     used = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
     if arch == "cuda" and used == "cpu":
@@ -46,6 +48,32 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) 
 
 def generation() -> int:
     return _generation
+
+
+@contextlib.contextmanager
+def _stderr_held():
+    """Hold what Taichi's C++ side writes to fd 2 while it starts: when ti.init fails it logs the error there
+    and then raises it, and the CLI reports the exception as its one line. Released if the block succeeds."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no fd 2 to hold
+        yield
+        return
+    with tempfile.TemporaryFile() as held:
+        os.dup2(held.fileno(), 2)
+        ok = False
+        try:
+            yield
+            ok = True
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            if ok:  # nothing was wrong: pass on whatever it said
+                held.seek(0)
+                text = held.read()
+                if text:
+                    os.write(2, text)
 
 
 def real():

@@ -13,7 +13,7 @@ contract (LINKS, bob_sizes(), reach(), lengths).
 import numpy as np
 import taichi as ti
 
-from . import integrators, keys, runtime
+from . import budget, integrators, keys, runtime
 from .errors import SimulationError
 
 DEFAULT_MAX_DRIFT = 0.05
@@ -57,6 +57,7 @@ class System(runtime.Launcher):
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
         q0, v0 = self.initial_state()
         self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0))
+        budget.check_steps(scene, self.substeps, self.h)  # "auto" is known only now: refuse before any work
         if subset is not None:
             q0, v0 = q0[subset], v0[subset]
         self.n, self.subset = len(q0), subset
@@ -101,8 +102,9 @@ class System(runtime.Launcher):
 
     # --------------------------------------------------------------- per-system parts (Python)
     def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
-        """A bound (rad/s) on the fastest rate of the linearised dynamics over the whole run from these
-        initial states, damping included: the step limit is the method's limit over it (render/stability.py)."""
+        """A bound (rad/s) on the fastest rate of the undamped linearised dynamics over the whole run from these
+        initial states: the step limit is the method's limit over it plus the damping rate (integrators.timestep,
+        render/stability.py)."""
         raise NotImplementedError
 
     def deviation(self, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:

@@ -15,7 +15,9 @@ class Elastic(System):
     DOC = "two springs of rest lengths `lengths`, k = stiffness / rest length (Newton in x, y)"
     D = 4  # q = (x1, y1, x2, y2) with the pivot at the origin, v likewise
     LINKS = ("spring", "spring")
-    KEYS = {"stiffness": Real(2e3, 0.0, 1e12, lo_open=True)}  # Young's-modulus-like E, as in the seed
+    # Young's-modulus-like E, as in the seed. Within [1e-6, 1e12]: the spring constants k = E/l this gives
+    # with lengths in [1e-6, 1e6] stay finite in f32; how fast a stiff spring makes the step is budget.py's.
+    KEYS = {"stiffness": Real(2e3, 1e-6, 1e12)}
     METHODS = ("symplectic_euler", "rk4", "verlet", "yoshida4")
     DEFAULT_EFFECTS = ("springs", "bobs", "trails", "energy")
     STATE = {"pos": ("q", (2, 2)), "vel": ("v", (2, 2))}
@@ -31,11 +33,10 @@ class Elastic(System):
         super().__init__(scene, *args, **kwargs)
 
     def omega_max(self, q0, v0) -> float:
-        """Fastest linear mode of the two springs along the chain (sqrt of the top eigenvalue of M⁻¹K), plus the
-        damping rate, which the explicit methods meet on the real axis."""
+        """Fastest linear mode of the two springs along the chain: sqrt of the top eigenvalue of M⁻¹K."""
         k1, k2, m1, m2 = self.k1, self.k2, self.m1, self.m2
         mk = np.array([[(k1 + k2) / m1, -k2 / m1], [-k2 / m2, k2 / m2]])
-        return math.sqrt(max(np.linalg.eigvals(mk).real)) + (self.damping if self.damped else 0.0)
+        return math.sqrt(max(np.linalg.eigvals(mk).real))
 
     def deviation(self, qa, qb):
         """The farthest bob's distance apart, as a fraction of the total rest length."""

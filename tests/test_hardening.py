@@ -1,0 +1,244 @@
+"""The hostile-input audit (issue 13): each case run as a user runs it, in a real process limited to 60 s and
+8 GB of address space. Each asserts the exit code, at most one stderr line, no traceback, and that nothing
+was written where nothing should be.
+
+Taichi reserves 1 GiB of virtual memory when it starts (its host memory pool): under RLIMIT_AS = 1 GiB it
+cannot start at all, under 2 GiB a render runs. 8 GB is the audit's limit and holds every case here.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import ROOT, run_cli
+
+ADDRESS_SPACE = 8 << 30  # bytes
+TINY = ["--set", "video.width=32", "--set", "video.height=32", "--set", "video.duration=0.2", "--no-progress"]
+GOOD = """\
+name = "{name}"
+system = "rigid"
+[pendulums]
+count = 2
+[video]
+width = 32
+height = 32
+fps = 10
+duration = 0.3
+gif_width = 32
+"""
+
+
+def run_user(*args, cwd, fsize=None, env=None):
+    """`pendulum ARGS` in a real process, within 60 s and ADDRESS_SPACE (and at most `fsize` bytes a file)."""
+    def limits():
+        resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+        if fsize is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (fsize, fsize))
+    return run_cli(*args, cwd=cwd, timeout=60, preexec_fn=limits, env=env)
+
+
+def one_line(r, code: int, *needles: str) -> str:
+    """The run exited with `code` and said so in one stderr line holding every needle, with no traceback."""
+    assert r.returncode == code, r.stderr
+    assert "Traceback" not in r.stderr, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    for needle in needles:
+        assert needle in lines[0], f"{needle!r} not in {lines[0]!r}"
+    return lines[0]
+
+
+def nothing_in(folder: Path) -> bool:
+    return not folder.exists() or not any(folder.rglob("*"))
+
+
+# ------------------------------------------------------------------ refused up front: exit 2, nothing written
+
+REFUSED = {
+    "dt_1e-12_render": (["render", "classic", "--out", "{out}", *TINY, "--set", "integrator.dt=1e-12"],
+                        ["classic.toml", "integrator.dt", "dt too small", "steps", "exceed the step budget"]),
+    "dt_1e-12_simulate": (["simulate", "classic", "--out", "{out}/c.npz", "--set", "integrator.dt=1e-12"],
+                          ["classic.toml", "integrator.dt", "dt too small", "steps", "exceed the step budget"]),
+    "omega_1e200": (["render", "classic", "--out", "{out}", *TINY, "--set", "pendulums.omega1=1e200"],
+                    ["classic.toml", "pendulums.omega1", "1e+200"]),
+    "lengths_1e-200": (["render", "classic", "--out", "{out}", *TINY, "--set", "pendulums.lengths=[1e-200,1e-200]"],
+                       ["classic.toml", "pendulums.lengths", "1e-200", "> 0"]),
+    "simulate_100_GB": (["simulate", "rigid_chaos", "--out", "{out}/x.npz", "--set", "pendulums.count=4000000",
+                         "--set", "video.duration=60"],
+                        ["rigid_chaos.toml", "pendulums.count", "needs about", "TB of memory", "limit"]),
+    "simulate_out_is_a_directory": (["simulate", "classic", "--out", "{tmp}/dir.npz"],
+                                    ["--out", "dir.npz", "is a directory"]),
+    "render_threads_0": (["render", "classic", "--out", "{out}", *TINY, "--threads", "0"], ["--threads", "'0'"]),
+    "render_threads_-1": (["render", "classic", "--out", "{out}", *TINY, "--threads", "-1"], ["--threads", "'-1'"]),
+    "batch_threads_0": (["batch", "classic", "--out", "{out}", "--threads", "0"], ["--threads", "'0'"]),
+    "batch_threads_-1": (["batch", "classic", "--out", "{out}", "--threads", "-1"], ["--threads", "'-1'"]),
+    "batch_scheduler_bad_port": (["batch", "classic", "--out", "{out}", "--scheduler", "tcp://127.0.0.1:abc"],
+                                 ["--scheduler", "tcp://127.0.0.1:abc", "port"]),
+    # the preset's own 20 s: 1.6e12 steps (12 frames of TINY would be 1.6e10, within the budget, and run)
+    "stiff_light_springs_step_budget": (["render", "elastic_fan", "--out", "{out}", *TINY[:4], "--no-progress",
+                                         "--set",
+                                         "pendulums.stiffness=1e12", "--set", "pendulums.masses=[1e-6,1e-6]"],
+                                        ["elastic_fan.toml", "integrator.dt", "exceed the step budget"]),
+    "damping_1000_symplectic_euler": (["render", "classic", "--out", "{out}", *TINY, "--set",
+                                       "pendulums.damping=1000", "--set", "integrator.dt=0.01", "--set",
+                                       "integrator.method=symplectic_euler"],
+                                      ["classic.toml", "integrator.dt", "stability limit", "damping 1000"]),
+    "fractal_on_springs": (["render", "elastic_fan", "--out", "{out}", *TINY, "--set", 'effects=["fractal"]',
+                            "--set", "pendulums.layout=grid", "--set", "pendulums.count=1024"],
+                           ["elastic_fan.toml", "effects", "fractal", "angles"]),
+}
+
+
+@pytest.mark.parametrize("case", REFUSED, ids=list(REFUSED))
+def test_refused_up_front_with_one_line(tmp_path, case):
+    args, needles = REFUSED[case]
+    out = tmp_path / "out"
+    (tmp_path / "dir.npz").mkdir()
+    r = run_user(*[a.format(out=out, tmp=tmp_path) for a in args], cwd=tmp_path)
+    one_line(r, 2, *needles)
+    assert nothing_in(out), list(out.rglob("*"))
+    assert nothing_in(tmp_path / "dir.npz")
+
+
+def test_a_250_character_name_is_refused(tmp_path):
+    preset = tmp_path / "long.toml"
+    preset.write_text(GOOD.format(name="n" * 250))
+    r = run_user("render", preset, "--out", tmp_path / "out", "--no-progress", cwd=tmp_path)
+    one_line(r, 2, "long.toml", "name", "longer than the limit of 100 characters")
+    assert nothing_in(tmp_path / "out")
+
+
+def test_two_presets_with_the_same_name_are_refused_naming_both(tmp_path):
+    for stem in ("first", "second"):
+        (tmp_path / f"{stem}.toml").write_text(GOOD.format(name="same"))
+    r = run_user("render", "first.toml", "second.toml", "--out", "out", "--no-progress", cwd=tmp_path)
+    one_line(r, 2, "first.toml", "second.toml", "name", "'same'")
+    assert nothing_in(tmp_path / "out")
+
+
+def test_a_file_where_the_render_folder_goes_is_refused(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "classic").write_text("mine")
+    r = run_user("render", "classic", "--out", "out", *TINY, cwd=tmp_path)
+    one_line(r, 2, "--out", "classic is a file")
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["classic"]
+    assert (tmp_path / "out" / "classic").read_text() == "mine"
+
+
+# ------------------------------------------------------------------ runs, or fails cleanly while running
+
+
+def test_no_gravity_is_a_still_pendulum(tmp_path):
+    """classic without gravity and at rest: nothing limits the step (omega_max = 0), nothing moves."""
+    r = run_user("simulate", "classic", "--out", "c.npz", "--set", "pendulums.gravity=0",
+                 "--set", "video.duration=0.5", "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    theta = np.load(tmp_path / "c.npz")["theta"]
+    assert theta.shape == (30, 1, 2) and np.all(theta == theta[0])
+    np.testing.assert_allclose(theta[0, 0], [math.radians(120), math.radians(-10)])
+    r = run_user("render", "classic", "--out", "out", *TINY, "--set", "pendulums.gravity=0", cwd=tmp_path)
+    assert r.returncode == 0 and not r.stderr.strip(), r.stderr
+    assert (tmp_path / "out" / "classic" / "classic.mp4").stat().st_size > 0
+
+
+def test_simulate_to_a_full_disk_fails_with_one_line_and_leaves_nothing(tmp_path):
+    """RLIMIT_FSIZE makes every write past 1 MB fail with EFBIG, as a full disk fails with ENOSPC (Python
+    ignores SIGXFSZ). Taichi's kernel cache goes to a private folder: a write it cannot finish must not
+    leave a truncated entry in the user's cache."""
+    env = {**os.environ, "TI_OFFLINE_CACHE_FILE_PATH": str(tmp_path / "taichi-cache")}
+    out = tmp_path / "out" / "chaos.npz"  # 600 frames x 100 pendulums x 5 float64: ~2.4 MB
+    r = run_user("simulate", "rigid_chaos", "--out", out, "--set", "video.duration=10", "--no-progress",
+                 cwd=tmp_path, fsize=1 << 20, env=env)
+    one_line(r, 1, "failed", "File too large", "chaos.npz")
+    assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
+
+
+def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
+    (tmp_path / "p.toml").write_text(GOOD.format(name="p"))
+    first = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    mp4 = tmp_path / "out" / "p" / "p.mp4"
+    meta = json.loads((mp4.parent / "metadata.json").read_text())
+    good = mp4.read_bytes()
+    assert meta["outputs"]["p.mp4"] == len(good) and len(meta["outputs_sha256"]["p.mp4"]) == 64
+
+    again = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)
+    assert again.returncode == 0 and "0 ok, 1 skipped" in again.stdout, again.stdout  # intact: skipped
+
+    bad = bytearray(good)
+    bad[len(bad) // 2] ^= 0xFF  # one byte flipped: same size, other content
+    mp4.write_bytes(bytes(bad))
+    r = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0 and "1 ok, 0 skipped" in r.stdout, r.stdout + r.stderr
+    assert not r.stderr.strip() and "Traceback" not in r.stderr, r.stderr
+    redone = json.loads((mp4.parent / "metadata.json").read_text())["outputs_sha256"]["p.mp4"]
+    assert mp4.read_bytes() != bytes(bad) and redone == hashlib.sha256(mp4.read_bytes()).hexdigest()
+
+
+def test_a_render_killed_with_sigkill_leaves_parts_that_the_next_render_sweeps(tmp_path):
+    slow = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
+                             "--no-progress", "--set", "video.width=320", "--set", "video.height=180"],
+                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    target = tmp_path / "rigid_chaos"
+    deadline = time.time() + 120
+    while len(list(target.glob(".*.part"))) < 2 and time.time() < deadline:  # MP4 and GIF under way
+        time.sleep(0.05)
+    slow.send_signal(signal.SIGKILL)
+    slow.wait(timeout=30)
+    left = list(target.glob(".*.part"))
+    assert len(left) == 2, left  # what SIGKILL leaves: nothing could clean up
+
+    r = run_user("render", "rigid_chaos", "--out", tmp_path, *TINY, cwd=tmp_path)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    assert not list(tmp_path.rglob("*.part")), list(tmp_path.rglob("*.part"))
+    assert (target / "rigid_chaos.mp4").stat().st_size > 0
+
+
+def test_another_live_writers_parts_are_left_alone(tmp_path):
+    """Only the temporaries of a dead process are swept: one of a live process (here: this one) stays."""
+    from render import atomic
+
+    mine = atomic.temp_beside(tmp_path / "x.mp4")
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    stale = tmp_path / f".x.mp4.{atomic.HOST}-{dead}.abcdefgh.part"
+    stale.write_bytes(b"left by a killed render")
+    foreign = tmp_path / f".x.mp4.{'0' * 8 if atomic.HOST != '0' * 8 else '1' * 8}-1.abcdefgh.part"
+    foreign.write_bytes(b"another host's live render")
+    unrelated = tmp_path / ".x.mp4.notes.part"
+    unrelated.write_bytes(b"not ours")
+    assert atomic.sweep_stale(tmp_path) == [stale]
+    assert mine.exists() and foreign.exists() and unrelated.exists() and not stale.exists()
+    old = time.time() - atomic.FOREIGN_STALE_S - 60
+    os.utime(foreign, (old, old))  # a week without a write: its host's render is long over
+    assert atomic.sweep_stale(tmp_path) == [foreign]
+
+
+# ------------------------------------------------------------------ no traceback from anywhere
+
+
+def test_an_unexpected_error_is_one_line_and_debug_shows_the_traceback(tmp_path):
+    """Taichi cannot start under 1 GiB of address space (it reserves 1 GiB): nobody's fault in the input,
+    so exit 1 with one line; --debug and PENDULUM_DEBUG=1 add the traceback."""
+    def tight():
+        resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+
+    args = ["render", "classic", "--out", "out", *TINY]
+    r = run_cli(*args, cwd=tmp_path, timeout=60, preexec_fn=tight)
+    line = one_line(r, 1, "unexpected error", "--debug")
+    assert nothing_in(tmp_path / "out")
+    for argv, env in ((["--debug", *args], None), ([*args, "--debug"], None),
+                      (args, {**os.environ, "PENDULUM_DEBUG": "1"})):
+        r = run_cli(*argv, cwd=tmp_path, timeout=60, preexec_fn=tight, env=env)
+        assert r.returncode == 1 and "Traceback" in r.stderr and r.stderr.strip().splitlines()[-1] == line
