@@ -45,7 +45,7 @@ SCHEMA: dict[str, object] = {
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
     "pendulums": pendulum_keys(None),
     "integrator": {
-        "method": "rk4", "dt": "auto", "precision": "f64",
+        "method": "rk4", "dt": "auto", "precision": "f64", "trig": "inline",
         "allow_unstable": False, "max_drift": None, "tolerance": 1e-3, "min_faithful": 0.1,
     },
     "video": {
@@ -81,6 +81,7 @@ class Integrator:
     method: str
     dt: "float | str"
     precision: str
+    trig: str  # "inline": render/sincos.py (vectorises); "libm": the C library's, bit for bit as the seed ran
     allow_unstable: bool
     max_drift: float | None
     tolerance: float  # faithfulness: rad on any angle, or a fraction of the total length for positions

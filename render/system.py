@@ -4,7 +4,7 @@ kernels, the drawing contract and the watchdog.
 A system module (render/systems/) subclasses System, declares what the registry and the scene loader need as
 class attributes, and writes its physics once as Taichi functions:
 - accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group of LANES), so the
-  same code runs one pendulum or several packed side by side; trig through render/sincos.py, not libm;
+  same code runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
 - energy(q, v) and points(q) for one pendulum's vectors.
 The integrators (render/integrators.py) call force(); the canvas reads only points() and the Python-side
 contract (LINKS, bob_sizes(), reach(), lengths).
@@ -14,6 +14,7 @@ import numpy as np
 import taichi as ti
 
 from . import budget, integrators, keys, runtime
+from .sincos import sincos
 from .errors import SimulationError
 
 DEFAULT_MAX_DRIFT = 0.05
@@ -52,6 +53,7 @@ class System(runtime.Launcher):
         p = scene.pendulums
         self.count = p.count
         self.method = scene.integrator.method
+        self.libm = scene.integrator.trig == "libm"
         self.damped = scene.has("damping")
         self.damping = p.damping
         self.g = p.gravity
@@ -100,7 +102,7 @@ class System(runtime.Launcher):
 
     def advance_by(self, substeps: int, h: float | None = None):
         """`substeps` steps of h (default: the scene's step)."""
-        self.advance(substeps, self.h if h is None else h)
+        (self.advance_libm if self.libm else self.advance)(substeps, self.h if h is None else h)
 
     # --------------------------------------------------------------- per-system parts (Python)
     def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
@@ -176,6 +178,14 @@ class System(runtime.Launcher):
 
     # --------------------------------------------------------------- shared Taichi parts
     @ti.func
+    def sincos(self, x):
+        """(sin x, cos x) for accel: inline (render/sincos.py) unless the scene asks for libm's exact bits."""
+        if ti.static(self.libm):
+            return ti.sin(x), ti.cos(x)
+        else:
+            return sincos(x)
+
+    @ti.func
     def lane_force(self, q, v):
         a = self.accel(q, v)
         if ti.static(self.damped):
@@ -217,6 +227,19 @@ class System(runtime.Launcher):
                     self.q[i], self.v[i] = Q[:, lane], V[:, lane]
                     if not (ti.abs(Q[:, lane]).max() < 1e30 and ti.abs(V[:, lane]).max() < 1e30):  # also NaN
                         ti.atomic_min(self.bad[None], i)
+
+    @ti.kernel
+    def advance_libm(self, substeps: ti.i32, h: float):
+        """advance for scenes that pin libm's sin/cos: one pendulum per iteration, as before the chunks (libm
+        calls do not vectorise), so its results are the earlier releases' to the bit (LLVM merges sin and cos
+        differently in the chunked loop, and in f32 from upright those bits decide the chaos)."""
+        for i in range(self.n):
+            q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
+            for _ in range(substeps):
+                q, v = integrators.step(self, q, v, h)
+            self.q[i], self.v[i] = q[:, 0], v[:, 0]
+            if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
+                ti.atomic_min(self.bad[None], i)
 
     @ti.kernel
     def energies(self, first: ti.i32):

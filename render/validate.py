@@ -20,6 +20,7 @@ from .quality import LEVELS
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
+TRIGS = ("inline", "libm")
 FORMATS = ("mp4", "gif")
 LAYOUTS = ("fan", "grid")
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
@@ -210,6 +211,7 @@ class Validator:
                 self.fail("integrator.dt", f"must be a number of seconds or \"auto\", got {clip(repr(dt))}")
             dt = self.real(d, "integrator", "dt", 0.0, 1.0, lo_open=True)
         prec = self.choice(d["integrator"]["precision"], "integrator.precision", PRECISIONS)
+        trig = self.choice(d["integrator"]["trig"], "integrator.trig", TRIGS)
         allow = d["integrator"]["allow_unstable"]
         if not isinstance(allow, bool):
             self.fail("integrator.allow_unstable", f"must be true or false, got {tname(allow)}")
@@ -218,8 +220,8 @@ class Validator:
             drift = self.real(d, "integrator", "max_drift", 0.0, 1e6, lo_open=True)
         tol = self.real(d, "integrator", "tolerance", 0.0, 1.0, lo_open=True)
         least = self.real(d, "integrator", "min_faithful", 0.0, 1.0)
-        return {"method": method, "dt": dt, "precision": prec, "allow_unstable": allow, "max_drift": drift,
-                "tolerance": tol, "min_faithful": least}
+        return {"method": method, "dt": dt, "precision": prec, "trig": trig, "allow_unstable": allow,
+                "max_drift": drift, "tolerance": tol, "min_faithful": least}
 
     def effects(self, d, system, pend) -> tuple[str, ...]:
         given = d["effects"]
