@@ -57,7 +57,9 @@ def to_byte(c):
 
 @ti.data_oriented
 class Canvas(runtime.Launcher):
-    def __init__(self, scene, sim):
+    def __init__(self, scene, sim, info=None):
+        """info: what the `hud` effect says beyond the drawing contract (render/hud.py's Info; from the scene
+        alone if not given)."""
         v, self.scene, self.sim = scene.video, scene, sim
         self.w, self.h, self.n = v.width, v.height, sim.n
         self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
@@ -82,6 +84,11 @@ class Canvas(runtime.Launcher):
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
             self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
+        self.hud = None
+        if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
+            from .hud import Hud, Info
+            self.hud = Hud(scene, sim, info or Info.of(scene), self.w, self.h)
+        self.fps = v.fps
         self.frame_no = 0
 
     def restart(self):
@@ -97,8 +104,10 @@ class Canvas(runtime.Launcher):
             return np.empty((self.h, self.w, 3), np.uint8)  # every pixel is written
         return np.zeros((self.h, self.w, 3), np.uint8)
 
-    def draw(self, out: np.ndarray | None = None) -> np.ndarray:
-        """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given."""
+    def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
+        """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given.
+
+        t is the simulated time, for the HUD's clock (default: one frame per draw since the start)."""
         if out is None:
             out = self.new_frame()
         elif not self.fractal:
@@ -116,6 +125,8 @@ class Canvas(runtime.Launcher):
         if self.bobs_on:
             self.launch("draw_bobs")
         self.launch("compose_frame", out)
+        if self.hud is not None:
+            self.hud.draw(out, self.frame_no / self.fps if t is None else t)
         self.frame_no += 1
         return out
 
