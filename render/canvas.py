@@ -66,22 +66,19 @@ class Canvas(runtime.Launcher):
         self.w, self.h, self.n = v.width, v.height, sim.n
         self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
         self.trails, self.fractal = scene.has("trails"), scene.has("fractal")
-        self.rainbow = v.palette == "rainbow"
-        self.glow, self.trail_light, self.glowing = None, 1.0, scene.has("glow")
-        if self.glowing:  # additive light in fixed point, tone-mapped (render/glow.py)
-            from . import glow
-            self.glow = glow.Glow(TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds)))
-            self.gain, self.trail_light = glow.gain(self.n), glow.TRAIL
-        light = ti.f32 if self.glow is None else ti.i32  # what the layers hold: colour, or fixed-point light
-        # Glow's layers are stored tile by tile: thousands of lines in every direction touch them all over,
-        # and a steep line in row-major order would miss the cache at every pixel.
-        self.block = None if self.glow is None else TILE
+        self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
+        self.rainbow, self.glowing = v.palette == "rainbow", scene.has("glow")
+        self.glow, self.trail_light, light, block = None, 1.0, ti.f32, None  # layers: colour, row by row
+        if self.glowing:  # fixed-point light (render/glow.py), stored tile by tile: thousands of lines in every
+            from . import glow  # direction touch it all over, and a steep line would miss the cache at every pixel
+            self.glow, self.gain, self.trail_light = glow.Glow(self.decay), glow.gain(self.n), glow.TRAIL
+            light, block = ti.i32, TILE
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
         self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
         if not self.fractal:
             # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
-            self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, self.block)
+            self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
             self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
             # pixels per metre, the pivot at the centre: the full reach fits with a margin
             self.scale = 0.46 * min(self.w, self.h) / sim.reach()
@@ -92,10 +89,9 @@ class Canvas(runtime.Launcher):
             self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
             self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
-            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, self.block)
+            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
-            self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
         self.hud = None
         if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
             from .hud import Hud, Info

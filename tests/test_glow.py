@@ -69,3 +69,16 @@ def test_glow_and_palette_mistakes_exit_2_naming_the_key(sets, key, tmp_path):
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert f"presets/{args[1]}.toml: {key}:" in r.stderr
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("name, drawn", [("elastic_fan", ["springs", "bobs", "trails"]),
+                                         ("triple_chaos", ["rods", "bobs", "trails"])])
+def test_every_system_draws_under_glow_with_the_hud(name, drawn, tmp_path):
+    effects = '","'.join(drawn + ["glow", "hud"])
+    scene = load(name, ["video.width=160", "video.height=90", "video.fps=10", "video.duration=0.3",
+                        'video.formats=["mp4"]', f'effects=["{effects}"]'])
+    meta, frames = frames_of(scene, tmp_path)
+    assert {"glow.tone", "hud.history"} <= set(meta["fields"])
+    assert meta["fields"]["canvas.frame"] == 160 * 96 * 3 * 4  # fixed-point light, whole 8x8 tiles
+    centre = frames[:, 20:70, 50:110]  # where the pendulums are (the HUD keeps to the corners)
+    assert (centre.max(axis=(1, 2, 3)) > 100).all()
