@@ -176,11 +176,10 @@ class Hud(runtime.Launcher):
     def draw(self, out: np.ndarray, t: float):
         """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
         frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
-        self.launch("hud_graph", out, frame, self.x_of(t))
+        spread = self.launch("hud_graph", out, frame, self.x_of(t))  # returned: no field read, no extra launch
         rows = [self.static, self.text(f"t = {t:5.2f} s", self.m, self.m, self.clock_colour(t), self.big, self.bs)]
         if self.fan:
-            label = f"spread {metres(float(self.spread[None]))}" if self.words else \
-                f"Δ {metres(float(self.spread[None]))}"
+            label = f"{'spread' if self.words else 'Δ'} {metres(spread)}"
             rows.append(self.text(label, *self.value_at, CURVE))
         self.font.draw_glyphs(out, np.concatenate(rows))
 
@@ -208,10 +207,12 @@ class Hud(runtime.Launcher):
         return c
 
     @ti.kernel
-    def hud_graph(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), frame: ti.i32, now: ti.i32):
+    def hud_graph(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), frame: ti.i32, now: ti.i32) -> float:
+        """The spread now (returned), its history, and the graph and timeline into `out`."""
         if ti.static(self.fan):
             self.spread[None] = 0.0
-            for i in range(self.n - 1):  # parallel; a max does not depend on the order
+            ti.loop_config(serialize=True)  # a few thousand pendulums at most: waking threads costs more
+            for i in range(self.n - 1):
                 a, b = self.sim.points(self.sim.q[i]), self.sim.points(self.sim.q[i + 1])
                 d = ti.Vector([b[self.tip, 0] - a[self.tip, 0], b[self.tip, 1] - a[self.tip, 1]]).norm()
                 ti.atomic_max(self.spread[None], d)
@@ -235,6 +236,10 @@ class Hud(runtime.Launcher):
                     c = self.spread_colour(f)
                     for j in range(self.th):
                         self.column(out, x, yp - j, y - j, c)
+        value = 0.0
+        if ti.static(self.fan):
+            value = self.spread[None]
+        return value
 
     @ti.func
     def y_px(self, v):

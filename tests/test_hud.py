@@ -83,3 +83,13 @@ def test_a_long_caption_is_cut_to_its_strip_and_nothing_leaves_the_corners():
     caption_cols = np.nonzero(strip[:, h.gx1 + 1:].any(0))[0] + h.gx1 + 1
     assert caption_cols.min() > h.gx1 and caption_cols.max() >= W - h.m - 6  # cut, up to its last cell
     assert added.mean() < 0.1  # the HUD is a frame around the picture, not over it
+
+
+def test_a_single_pendulum_has_a_clock_and_a_timeline_but_no_spread():
+    canvas, frames, _ = run("classic")
+    h = canvas.hud
+    assert not h.fan and not hasattr(h, "spread")
+    box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]
+    want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *hud.faces(H)[1])
+    np.testing.assert_array_equal(frames[-1][box], want[box])
+    assert frames[-1][h.gy1 + 1, h.gx0:h.x_of(0.4)].min() > 0  # the timeline, lit up to now
