@@ -75,11 +75,12 @@ class Source:
 
     def __init__(self, scene, arch: str = "cpu", threads: int | None = None):
         from .canvas import Canvas
+        from .hud import Info
 
         self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
         self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
         self.sim = make_system(self.scene)
-        self.canvas = Canvas(self.scene, self.sim)
+        self.canvas = Canvas(self.scene, self.sim, Info.of(self.scene, self.sim.h, self.cert))
         self.name, self.frames = self.scene.name, self.scene.frames
         self.timings = {**before, "simulate": 0.0, "draw": 0.0}
         self.reset(rewind=False)
@@ -95,7 +96,7 @@ class Source:
         """The next frame as H×W×3 uint8, written into `out` if given (else a new array)."""
         self.index = next(self._steps)
         t = time.perf_counter()
-        frame = self.canvas.draw(out)
+        frame = self.canvas.draw(out, self.index / self.scene.video.fps)
         self.timings["draw"] += time.perf_counter() - t
         return frame
 

@@ -50,7 +50,7 @@ SCHEMA: dict[str, object] = {
     },
     "video": {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
-        "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20,
+        "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20, "palette": "fan",
     },
 }
 
@@ -97,6 +97,7 @@ class Video:
     trail_seconds: float
     gif_width: int
     gif_fps: int
+    palette: str = "fan"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -23,7 +23,10 @@ PRECISIONS = ("f32", "f64")
 FORMATS = ("mp4", "gif")
 LAYOUTS = ("fan", "grid")
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal")
+# New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow")
+DRAWN = ("rods", "springs", "bobs", "trails")  # effects that draw the pendulums (glow composes these)
+PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/canvas.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
 MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
 MAX_PIXELS = 3840 * 2160
@@ -176,8 +179,9 @@ class Validator:
         if gw % 2:
             self.fail("video.gif_width", f"must be even, got {gw}")
         gfps = self.integer(d, "video", "gif_fps", 1, 50)
+        palette = self.choice(d["video"]["palette"], "video.palette", PALETTES)
         return {"width": w, "height": h, "fps": fps, "duration": dur, "formats": formats, "trail_seconds": trail,
-                "gif_width": gw, "gif_fps": gfps}
+                "gif_width": gw, "gif_fps": gfps, "palette": palette}
 
     def pendulums(self, d, system, video) -> dict:
         layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
@@ -241,11 +245,13 @@ class Validator:
                           + ")")
             if pend["layout"] != "grid":
                 self.fail("effects", "'fractal' colours one pendulum per pixel and needs pendulums.layout = \"grid\"")
-            clash = [e for e in eff if e in ("rods", "springs", "bobs", "trails")]
+            clash = [e for e in eff if e in DRAWN + ("hud", "glow")]
             if clash:
                 self.fail("effects", f"'fractal' fills every pixel; it cannot be combined with {clash}")
         elif pend["layout"] == "grid":
             self.fail("pendulums.layout", "a grid of pendulums is drawn with effects = [\"fractal\"]")
+        if "glow" in eff and not any(e in eff for e in DRAWN):
+            self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
 
 

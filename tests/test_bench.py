@@ -11,7 +11,7 @@ from render import pipeline
 from render.scene import load
 
 KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps", "fractal_peak_mem_mb",
-        "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
+        "rainbow_1000_draw_fps", "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
 
 
 @pytest.mark.slow
@@ -25,14 +25,14 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
         assert isinstance(val, (int, float)) and not isinstance(val, bool), (key, val)
         assert math.isfinite(val) and val > 0, (key, val)
     assert rep["quick"] is True
-    assert set(rep["targets"]) == set(KEYS[:4]) and all(isinstance(t["met"], bool) for t in rep["targets"].values())
+    assert set(rep["targets"]) == set(KEYS[:5]) and all(isinstance(t["met"], bool) for t in rep["targets"].values())
     cases = {(s["system"], s["precision"]) for s in rep["sim"] if s["n"] == 10**5}
     assert cases == {("rigid", "f32"), ("rigid", "f64"), ("elastic", "f32"), ("elastic", "f64")}
     # the numpy baseline integrates the same equations: f64 agrees to round-off, f32 to its own precision
     for s in rep["sim"]:
         assert s["agree"] < (1e-9 if s["precision"] == "f64" else 1e-3), s
     md = (out / "report.md").read_text()
-    assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md
+    assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md and "## rainbow_1000" in md
     assert not list(out.glob(".*")), "temporary files left behind"
 
 
