@@ -14,7 +14,7 @@ import re
 import tomllib
 from pathlib import Path
 
-from . import keys, registry
+from . import grid, keys, registry
 from .errors import SceneError
 from .quality import LEVELS, check_level
 
@@ -23,8 +23,9 @@ PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
-FORMATS = ("mp4", "gif")
+FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
 LAYOUTS = ("fan", "grid")
+FRACTALS = ("angles", "flip_time", "divergence")  # how a map (effects = ["fractal"]) colours its pixels
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal")
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
@@ -38,7 +39,8 @@ REQUIRED = object()  # schema default for keys a preset must state: the scene is
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
 FAN_KEYS = {"gap": "spread", "spread": "gap"}
-COMMON_PENDULUM_KEYS = {"count": REQUIRED, "layout": "fan", "spread": 1e-4, "gap": None, "gravity": 9.8,
+# A grid derives its count from the frame (render/grid.py): one pendulum per pixel of the plot.
+COMMON_PENDULUM_KEYS = {"count": None, "layout": "fan", "spread": 1e-4, "gap": None, "gravity": 9.8,
                         "damping": 0.0}
 
 
@@ -58,6 +60,7 @@ SCHEMA: dict[str, object] = {
     "system": REQUIRED,
     "effects": None,
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
+    "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64",
@@ -66,6 +69,11 @@ SCHEMA: dict[str, object] = {
     "video": {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
         "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20,
+    },
+    "map": {  # fractal maps only
+        "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
+        "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
+        "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
     },
 }
 
@@ -115,6 +123,13 @@ class Video:
 
 
 @dataclasses.dataclass(frozen=True)
+class MapSpec:
+    epsilon: float
+    threshold: float
+    trust_stride: int
+
+
+@dataclasses.dataclass(frozen=True)
 class Scene:
     name: str
     description: str
@@ -124,6 +139,8 @@ class Scene:
     integrator: Integrator
     video: Video
     quality: str | None = None
+    fractal: str | None = None  # a map's colouring, None for a fan
+    map: MapSpec | None = None
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -151,6 +168,8 @@ class Scene:
     def replace(self, **sections) -> "Scene":
         """A copy with whole sections or fields swapped, e.g. replace(integrator={...})."""
         d = self.to_dict()
+        if d["pendulums"]["layout"] == "grid" and "count" not in sections.get("pendulums", {}):
+            del d["pendulums"]["count"]  # derived again from the (new) frame
         for k, v in sections.items():
             if isinstance(v, dict):
                 d[k].update(v)
@@ -337,13 +356,39 @@ class _Validator:
             self.fail("description", f"must be a string, got {_tname(d['description'])}")
         system = self.choice(d["system"], "system", SYSTEMS)
         video = self.video(d)
-        pend = self.pendulums(d, system, video)
+        fractal = self.fractal(d, system)
+        pend = self.pendulums(d, system, video, fractal)
         integ = self.integrator(d, system)
-        effects = self.effects(d, system, pend)
+        effects = self.effects(d, system, pend, fractal)
+        if "fractal" in effects and fractal is None:
+            fractal = "angles"
+        mp = self.map(d, fractal)
         quality = d["quality"]
         if quality is not None:
             check_level(self.choice(quality, "quality", LEVELS), self.src)
-        return Scene(name, d["description"], system, effects, pend, integ, video, quality, source=self.src)
+        return Scene(name, d["description"], system, effects, pend, integ, video, quality, fractal, mp,
+                     source=self.src)
+
+    def fractal(self, d, system) -> str | None:
+        val = d["fractal"]
+        if val is None:
+            return None
+        self.choice(val, "fractal", FRACTALS)
+        if not registry.get(system).ANGLES:
+            self.fail("fractal", f"{val!r} colours pixels by link angles, and this system's state is not angles "
+                      f"(systems with angles: {', '.join(n for n in SYSTEMS if registry.get(n).ANGLES)})")
+        return val
+
+    def map(self, d, fractal) -> MapSpec:
+        given = self.given.get("map") or {}
+        changed = [k for k, val in given.items() if val != SCHEMA["map"].get(k)]  # (a fan's own dict round trips)
+        if fractal is None and changed:
+            self.fail(f"map.{changed[0]}", "only a fractal map (effects = [\"fractal\"]) has this key")
+        eps = self.real(d, "map", "epsilon", 0.0, 1.0, lo_open=True)
+        thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
+        if fractal == "divergence" and thr <= eps:
+            self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
+        return MapSpec(eps, thr, self.integer(d, "map", "trust_stride", 1, 4096))
 
     def video(self, d) -> Video:
         w = self.integer(d, "video", "width", 16, 7680)
@@ -365,12 +410,20 @@ class _Validator:
         gfps = self.integer(d, "video", "gif_fps", 1, 50)
         return Video(w, h, fps, dur, formats, trail, gw, gfps)
 
-    def pendulums(self, d, system, video) -> Pendulums:
+    def pendulums(self, d, system, video, fractal) -> Pendulums:
         layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
+        if layout == "grid":
+            want = grid.pendulums(video.width, video.height, fractal)
+            if d["pendulums"]["count"] is None:
+                d["pendulums"]["count"] = want
+            lay = grid.layout(video.width, video.height)
+            if d["pendulums"]["count"] != want:
+                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video.width}x"
+                          f"{video.height} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+        elif d["pendulums"]["count"] is None:
+            self.fail("pendulums.count", "missing (this key is required)")
         count = self.integer(d, "pendulums", "count", 1, MAX_PENDULUMS)
-        if layout == "grid" and count != video.width * video.height:
-            self.fail("pendulums.count", f"a grid layout has one pendulum per pixel: "
-                      f"{video.width}x{video.height} = {video.width * video.height}, got {count}")
         out = {"count": count, "layout": layout}
         out.update({k: self.declared(d, "pendulums", k, spec)
                     for k, spec in registry.get(system).preset_keys().items()})
@@ -402,10 +455,14 @@ class _Validator:
         least = self.real(d, "integrator", "min_faithful", 0.0, 1.0)
         return Integrator(method, dt, prec, allow, drift, tol, least)
 
-    def effects(self, d, system, pend) -> tuple[str, ...]:
+    def effects(self, d, system, pend, fractal) -> tuple[str, ...]:
         given = d["effects"]
         cls = registry.get(system)
+        if given is None and fractal is not None:
+            given = ["fractal"]  # a colouring names a map
         eff = list(cls.DEFAULT_EFFECTS if given is None else self.strings(given, "effects", EFFECTS))
+        if fractal is not None and "fractal" not in eff:
+            self.fail("fractal", f"colours a map, and effects = {eff} draws none: use effects = [\"fractal\"]")
         if pend.damping > 0 and "damping" not in eff:
             eff.append("damping")  # a damped scene always simulates its damping
         if "damping" in eff and pend.damping == 0:
