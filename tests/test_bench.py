@@ -37,14 +37,17 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
 
 
 def small_fractal(w=64, h=36, seconds=0.2):
-    return load("fractal", [f"video.width={w}", f"video.height={h}", f"pendulums.count={w * h}",
-                            f"video.duration={seconds}", "video.gif_width=32"])
+    return load("fractal", [f"video.width={w}", f"video.height={h}", f"video.duration={seconds}",
+                            "video.gif_width=32"])
 
 
-def test_fractal_preset_is_a_full_720p_grid_without_trails_or_rods():
+def test_fractal_preset_is_a_720p_grid_without_trails_or_rods():
+    from render import grid
     s = load("fractal")
-    assert (s.video.width, s.video.height, s.pendulums.count) == (1280, 720, 1280 * 720)
-    assert s.pendulums.layout == "grid" and s.effects == ("fractal",)
+    lay = grid.layout(1280, 720)
+    assert (s.video.width, s.video.height, s.pendulums.count) == (1280, 720, lay.pixels)
+    assert lay.w == lay.h > 600  # a square plot of one pendulum per pixel, the axes and legend around it
+    assert s.pendulums.layout == "grid" and s.effects == ("fractal",) and s.fractal == "angles"
 
 
 def test_fractal_renders_one_pendulum_per_pixel(tmp_path):
@@ -53,10 +56,12 @@ def test_fractal_renders_one_pendulum_per_pixel(tmp_path):
     meta = pipeline.render(scene, tmp_path, frame_hook=lambda f, fr: frames.append(fr.copy()))
     frames = np.stack(frames)
     assert frames.shape == (scene.frames, 36, 64, 3)
-    assert sorted(meta["kernels"]) == ["fractal_colour", "rigid_advance"]
+    assert sorted(meta["kernels"]) == ["fractal_colour", "fractal_setup", "rigid_advance"]
     assert not [f for f in meta["fields"] if "trail" in f or f == "canvas.frame"], meta["fields"]
     # frame 0 colours each pixel by its starting angles: theta1 = -pi..pi left to right, theta2 = pi..-pi down
-    th1, th2 = np.meshgrid(np.linspace(-np.pi, np.pi, 64), np.linspace(np.pi, -np.pi, 36))
+    # (too small a frame for axes: the map fills it, one pendulum at the centre of each pixel)
+    centres = (np.arange(64) + 0.5) / 64, (np.arange(36) + 0.5) / 36
+    th1, th2 = np.meshgrid(np.pi * (2 * centres[0] - 1), np.pi * (1 - 2 * centres[1]))
     want = 0.5 + 0.5 * np.stack([np.sin(th1), np.sin(th2), np.cos(th1 + th2)], axis=-1)
     assert np.abs(frames[0].astype(int) - np.round(want * 255)).max() <= 1
     assert (frames[-1] != frames[0]).any()  # the pendulums move
