@@ -149,6 +149,21 @@ class Map(runtime.Launcher):
             self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")
         return out
 
+    def summary(self) -> dict:
+        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not."""
+        ev, until = self.event.to_numpy(), self.until.to_numpy()
+        t = np.float32(self.sim.t)
+        done, pending = ev >= 0, ev == PENDING
+        claim = np.where(done, ev, t)
+        lay, stride = self.lay, self.scene.map.trust_stride
+        return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "pixels": self.pixels, "time_scale_s": [self.lo, self.hi],
+                "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
+                            * len(grid.lattice_axis(lay.h, stride))},
+                "cannot_flip": int((ev == NEVER).sum()), "events": int(done.sum()),
+                "events_trusted": int((done & (claim <= until)).sum()), "pending": int(pending.sum()),
+                "pending_trusted": int((pending & (claim <= until)).sum())}
+
     def decorate(self) -> np.ndarray:
         """The static parts of every frame: background, axes, labels, colour bar and legend."""
         sim, i = self.sim, self.scene.integrator

@@ -136,6 +136,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             raise
         timings["total"] = time.perf_counter() - t_start
         meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen)
+        if scene.fractal:
+            meta["map"] = src.canvas.summary()
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
