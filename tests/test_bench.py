@@ -10,8 +10,9 @@ from conftest import run_cli
 from render import pipeline
 from render.scene import load
 
-KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps", "fractal_peak_mem_mb",
+KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_peak_mem_mb",
         "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
+TARGETS = {"end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps.flip_time", "fractal_peak_mem_mb"}
 
 
 @pytest.mark.slow
@@ -24,15 +25,19 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
         val = rep[key]
         assert isinstance(val, (int, float)) and not isinstance(val, bool), (key, val)
         assert math.isfinite(val) and val > 0, (key, val)
+    # DESIGN.md: fractal_fps per colouring, as a dict; each map rendered at 720p
+    assert set(rep["fractal_fps"]) == {"angles", "flip_time", "divergence"}
+    assert all(math.isfinite(v) and v > 0 for v in rep["fractal_fps"].values()), rep["fractal_fps"]
+    assert all(f["map"]["plot"]["width"] > 600 for f in rep["fractal"].values())
     assert rep["quick"] is True
-    assert set(rep["targets"]) == set(KEYS[:4]) and all(isinstance(t["met"], bool) for t in rep["targets"].values())
+    assert set(rep["targets"]) == TARGETS and all(isinstance(t["met"], bool) for t in rep["targets"].values())
     cases = {(s["system"], s["precision"]) for s in rep["sim"] if s["n"] == 10**5}
     assert cases == {("rigid", "f32"), ("rigid", "f64"), ("elastic", "f32"), ("elastic", "f64")}
     # the numpy baseline integrates the same equations: f64 agrees to round-off, f32 to its own precision
     for s in rep["sim"]:
         assert s["agree"] < (1e-9 if s["precision"] == "f64" else 1e-3), s
     md = (out / "report.md").read_text()
-    assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md
+    assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md and "| flip_time | fractal_flip |" in md
     assert not list(out.glob(".*")), "temporary files left behind"
 
 
