@@ -37,6 +37,7 @@ batch: $(BIN)/pendulum
 # Measure, then put the figures into README.md (generated blocks) and benchmarks/figures/. Run on a quiet machine.
 figures: $(BIN)/pendulum
 	$(BIN)/pendulum accuracy
+	$(BIN)/pendulum render benchmarks/fractal_flip_readme.toml --no-progress
 	$(BIN)/python benchmarks/seed_table.py
 	$(BIN)/python benchmarks/readme_figures.py
 

@@ -22,6 +22,7 @@ FIGURES = ROOT / "benchmarks" / "figures"
 IMAGES = {  # out/<source> -> benchmarks/figures/<name>
     "accuracy/work_precision_rigid_chaos.png": "work_precision_rigid_chaos.png",
     "accuracy/faithful_rigid_chaos.png": "faithful_rigid_chaos.png",
+    "fractal_flip_readme/fractal_flip_readme.png": "fractal_flip.png",
 }
 BLOCK = re.compile(r"(<!-- generated: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.S)
 

@@ -107,13 +107,16 @@ def legend(d: Decor, scene, lay: grid.Layout, times: tuple[float, float], x: int
         d.swatches.append((x, y + pad, ch * 4, ch, "angles"))
         y += 2 * ch + pad
     else:
+        room = (lay.width - x - pad) // cw  # characters that fit in the legend's column
         unit = "flip time [s]" if scene.fractal == "flip_time" else "time to part [s]"
+        if scene.fractal == "divergence":  # two bars side by side: labels as long as they fit
+            unit, apart = ("time to part [s]", "together: distance") if room >= 36 else ("t [s]", "|Δ|")
         d.texts.append((unit, x, y, small))
         y += ch + pad
         bar(d, x, y, ch, bar_h, times, lay, "time")
         if scene.fractal == "divergence":  # pairs still together: their distance, ε to the threshold
-            bx = x + ch + 8 * cw
-            d.texts.append(("together: distance", bx, y - ch - pad, small))
+            bx = x + max(ch + 8 * cw, (len(unit) + 2) * cw)
+            d.texts.append((apart, bx, y - ch - pad, small))
             m = scene.map
             d.swatches.append((bx, y, ch, bar_h, "distance"))
             for v, at in ((m.epsilon, 0.0), (m.threshold, 1.0)):
