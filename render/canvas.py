@@ -11,8 +11,6 @@ still-visible trail touched them; the others stay as the zeroed frame left them,
 them. The frame pass also clears the layer it reads and fades the trail in place, and it writes the output
 array itself (a kernel argument), so there is no separate clear, fade or field-to-numpy copy.
 """
-import math
-
 import numpy as np
 import taichi as ti
 
@@ -37,19 +35,6 @@ def hue(h):
 
 
 @ti.func
-def sin8(x):
-    """sin(x) to within 1e-4, plenty for a colour byte and about 3x cheaper than libm's call (fractal: 0.9 M
-    pixels x 3 per frame). Reduced to [-pi/2, pi/2], then the Taylor series to x^9 (error < 4e-6 there)."""
-    x = x - 2.0 * math.pi * ti.round(x * (0.5 / math.pi))
-    if x > 0.5 * math.pi:
-        x = math.pi - x
-    elif x < -0.5 * math.pi:
-        x = -math.pi - x
-    x2 = x * x
-    return x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))))
-
-
-@ti.func
 def to_byte(c):
     """One channel of the accumulated colour (f32) to a byte; monotone, so it commutes with the max."""
     return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
@@ -65,7 +50,7 @@ class Canvas(runtime.Launcher):
         v, self.scene, self.sim = scene.video, scene, sim
         self.w, self.h, self.n = v.width, v.height, sim.n
         self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
-        self.trails, self.fractal = scene.has("trails"), scene.has("fractal")
+        self.trails = scene.has("trails")
         self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
         self.rainbow, self.glowing = v.palette == "rainbow", scene.has("glow")
         self.glow, self.trail_light, light, block = None, 1.0, ti.f32, None  # layers: colour, row by row
@@ -76,18 +61,17 @@ class Canvas(runtime.Launcher):
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
         self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
-        if not self.fractal:
-            # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
-            self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
-            self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
-            # pixels per metre, the pivot at the centre: the full reach fits with a margin
-            self.scale = 0.46 * min(self.w, self.h) / sim.reach()
-            self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
-            self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
-            self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
-            self.tip = len(self.links) - 1
-            self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
-            self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
+        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
+        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
+        self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
+        # pixels per metre, the pivot at the centre: the full reach fits with a margin
+        self.scale = 0.46 * min(self.w, self.h) / sim.reach()
+        self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
+        self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
+        self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
+        self.tip = len(self.links) - 1
+        self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
+        self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
             self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
@@ -108,8 +92,6 @@ class Canvas(runtime.Launcher):
 
     def new_frame(self) -> np.ndarray:
         """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
-        if self.fractal:
-            return np.empty((self.h, self.w, 3), np.uint8)  # every pixel is written
         return np.zeros((self.h, self.w, 3), np.uint8)
 
     def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
@@ -118,11 +100,8 @@ class Canvas(runtime.Launcher):
         t is the simulated time, for the HUD's clock (default: one frame per draw since the start)."""
         if out is None:
             out = self.new_frame()
-        elif not self.fractal:
+        else:
             out.fill(0)  # compose_frame writes only the tiles something touched (a memset is far cheaper)
-        if self.fractal:
-            self.launch("fractal_colour", out)
-            return out
         self.launch("bob_pixels")
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0))
@@ -352,12 +331,3 @@ class Canvas(runtime.Launcher):
                 for k in ti.static(range(3)):
                     out[y, x, k] = to_byte(c[k])
         return lit
-
-    @ti.kernel
-    def fractal_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
-        """One pendulum per pixel: the two angles mapped to colour."""
-        for y, x in ti.ndrange(self.h, self.w):
-            q = self.sim.q[y * self.w + x]
-            c = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
-            for k in ti.static(range(3)):
-                out[y, x, k] = ti.cast(c[k] * 255.0 + 0.5, ti.u8)
