@@ -37,7 +37,11 @@ batch: $(BIN)/pendulum
 # Measure, then put the figures into README.md (generated blocks) and benchmarks/figures/. Run on a quiet machine.
 figures: $(BIN)/pendulum
 	$(BIN)/pendulum accuracy
+	$(BIN)/pendulum render benchmarks/fractal_flip_readme.toml --no-progress
 	$(BIN)/python benchmarks/seed_table.py
+	$(BIN)/python benchmarks/effects.py --clock cpu --out out/bench/effects.md
+	$(BIN)/python benchmarks/frame.py rigid_chaos --at 10 --out out/figures/hud_rigid_chaos.png
+	$(BIN)/python benchmarks/frame.py rainbow_1000 --at 5 --out out/figures/glow_rainbow_1000.png
 	$(BIN)/python benchmarks/readme_figures.py
 
 clean:

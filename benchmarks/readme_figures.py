@@ -22,6 +22,9 @@ FIGURES = ROOT / "benchmarks" / "figures"
 IMAGES = {  # out/<source> -> benchmarks/figures/<name>
     "accuracy/work_precision_rigid_chaos.png": "work_precision_rigid_chaos.png",
     "accuracy/faithful_rigid_chaos.png": "faithful_rigid_chaos.png",
+    "figures/hud_rigid_chaos.png": "hud_rigid_chaos.png",  # benchmarks/frame.py: one frame, as render draws it
+    "figures/glow_rainbow_1000.png": "glow_rainbow_1000.png",
+    "fractal_flip_readme/fractal_flip_readme.png": "fractal_flip.png",
 }
 BLOCK = re.compile(r"(<!-- generated: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.S)
 

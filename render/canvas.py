@@ -11,8 +11,6 @@ still-visible trail touched them; the others stay as the zeroed frame left them,
 them. The frame pass also clears the layer it reads and fades the trail in place, and it writes the output
 array itself (a kernel argument), so there is no separate clear, fade or field-to-numpy copy.
 """
-import math
-
 import numpy as np
 import taichi as ti
 
@@ -37,19 +35,6 @@ def hue(h):
 
 
 @ti.func
-def sin8(x):
-    """sin(x) to within 1e-4, plenty for a colour byte and about 3x cheaper than libm's call (fractal: 0.9 M
-    pixels x 3 per frame). Reduced to [-pi/2, pi/2], then the Taylor series to x^9 (error < 4e-6 there)."""
-    x = x - 2.0 * math.pi * ti.round(x * (0.5 / math.pi))
-    if x > 0.5 * math.pi:
-        x = math.pi - x
-    elif x < -0.5 * math.pi:
-        x = -math.pi - x
-    x2 = x * x
-    return x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))))
-
-
-@ti.func
 def to_byte(c):
     """One channel of the accumulated colour (f32) to a byte; monotone, so it commutes with the max."""
     return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
@@ -57,31 +42,45 @@ def to_byte(c):
 
 @ti.data_oriented
 class Canvas(runtime.Launcher):
-    def __init__(self, scene, sim):
+    TILE = TILE  # for render/glow.py, which composes the canvas's tiles
+
+    def __init__(self, scene, sim, info=None):
+        """info: what the `hud` effect says beyond the drawing contract (render/hud.py's Info; from the scene
+        alone if not given)."""
         v, self.scene, self.sim = scene.video, scene, sim
         self.w, self.h, self.n = v.width, v.height, sim.n
         self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
-        self.trails, self.fractal = scene.has("trails"), scene.has("fractal")
+        self.trails = scene.has("trails")
+        self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
+        self.rainbow, self.glowing = v.palette == "rainbow", scene.has("glow")
+        self.glow, self.trail_light, light, block = None, 1.0, ti.f32, None  # layers: colour, row by row
+        if self.glowing:  # fixed-point light (render/glow.py), stored tile by tile: thousands of lines in every
+            from . import glow  # direction touch it all over, and a steep line would miss the cache at every pixel
+            self.glow, self.gain, self.trail_light = glow.Glow(self.decay), glow.gain(self.n), glow.TRAIL
+            light, block = ti.i32, TILE
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
         self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
-        if not self.fractal:
-            # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
-            self.rgb = runtime.field("canvas.frame", ti.f32, (self.h, self.w), 3)
-            self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
-            # pixels per metre, the pivot at the centre: the full reach fits with a margin
-            self.scale = 0.46 * min(self.w, self.h) / sim.reach()
-            self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
-            self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
-            self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
-            self.tip = len(self.links) - 1
-            self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
-            self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
+        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
+        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
+        self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
+        # pixels per metre, the pivot at the centre: the full reach fits with a margin
+        self.scale = 0.46 * min(self.w, self.h) / sim.reach()
+        self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
+        self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
+        self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
+        self.tip = len(self.links) - 1
+        self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
+        self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
-            self.trail = runtime.field("canvas.trail", ti.f32, (self.h, self.w), 3)
+            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
-            self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
+        self.hud = None
+        if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
+            from .hud import Hud, Info
+            self.hud = Hud(scene, sim, info or Info.of(scene), self.w, self.h)
+        self.fps = v.fps
         self.frame_no = 0
 
     def restart(self):
@@ -93,19 +92,16 @@ class Canvas(runtime.Launcher):
 
     def new_frame(self) -> np.ndarray:
         """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
-        if self.fractal:
-            return np.empty((self.h, self.w, 3), np.uint8)  # every pixel is written
         return np.zeros((self.h, self.w, 3), np.uint8)
 
-    def draw(self, out: np.ndarray | None = None) -> np.ndarray:
-        """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given."""
+    def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
+        """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given.
+
+        t is the simulated time, for the HUD's clock (default: one frame per draw since the start)."""
         if out is None:
             out = self.new_frame()
-        elif not self.fractal:
+        else:
             out.fill(0)  # compose_frame writes only the tiles something touched (a memset is far cheaper)
-        if self.fractal:
-            self.launch("fractal_colour", out)
-            return out
         self.launch("bob_pixels")
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0))
@@ -116,18 +112,38 @@ class Canvas(runtime.Launcher):
         if self.bobs_on:
             self.launch("draw_bobs")
         self.launch("compose_frame", out)
+        if self.hud is not None:
+            self.hud.draw(out, self.frame_no / self.fps if t is None else t)
         self.frame_no += 1
         return out
 
     # ------------------------------------------------------------ primitives
     @ti.func
     def colour(self, i):
-        return hue(0.85 * i / ti.max(self.n - 1, 1) if self.n > 1 else 0.08)
+        """video.palette: "fan", red to violet over the fan; "rainbow", the whole hue circle, so that a
+        coherent fan adds up to white under glow (each channel averages 1/2 over the circle)."""
+        h = 0.85 * i / ti.max(self.n - 1, 1) if self.n > 1 else 0.08
+        if ti.static(self.rainbow):
+            h = i / self.n
+        return hue(h)
+
+    @ti.func
+    def ink(self, i, max_scale, max_lift):
+        """Pendulum i's colour for a primitive: dimmed and lifted towards grey under max compositing, its
+        share of the light under glow."""
+        c = self.colour(i)
+        if ti.static(not self.glowing):
+            c = max_scale * c + max_lift
+        else:
+            c = self.gain * c
+        return c
 
     @ti.func
     def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c):
         if 0 <= x < self.w and 0 <= y < self.h:
-            for k in ti.static(range(3)):
+            if ti.static(self.glowing):
+                self.glow.deposit(buf, y, x, c)
+            for k in ti.static(range(3) if not self.glowing else ()):
                 if ti.static(self.serial):
                     buf[y, x][k] = ti.max(buf[y, x][k], c[k])
                 else:
@@ -135,8 +151,17 @@ class Canvas(runtime.Launcher):
             tiles[y // TILE, x // TILE] = 1  # every writer stores the same 1: the race is harmless
 
     @ti.func
-    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c):
-        """Antialiased segment of half-width r, walked along its major axis (x, y in pixels)."""
+    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, flat: ti.template() = False):
+        """A line from a to b (x, y in pixels): under glow a hairline of light (render/glow.py; `flat`: a
+        trail's pieces, which must not overlap), else antialiased with half-width r."""
+        if ti.static(self.glowing):
+            self.glow.segment(self, buf, tiles, a, b, c, flat)
+        else:
+            self.max_segment(buf, tiles, a, b, r, c)
+
+    @ti.func
+    def max_segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c):
+        """Antialiased segment of half-width r, walked along its major axis, composed with a max."""
         swap = ti.abs(b[1] - a[1]) > ti.abs(b[0] - a[0])
         if swap:
             a, b = ti.Vector([a[1], a[0]]), ti.Vector([b[1], b[0]])
@@ -204,7 +229,7 @@ class Canvas(runtime.Launcher):
         for i in range(self.n):
             p = self.pos[i, self.tip]  # the last bob leaves the trail
             a = p if first else self.last[i]
-            self.segment(self.trail, self.lit, a, p, self.lw, 0.9 * self.colour(i))
+            self.segment(self.trail, self.lit, a, p, self.lw, self.ink(i, 0.9, 0.0) * self.trail_light, True)
             self.last[i] = p
 
     @ti.kernel
@@ -214,7 +239,7 @@ class Canvas(runtime.Launcher):
             for j in ti.static(range(len(self.links))):
                 if ti.static(self.links[j] == "rod"):
                     self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
-                                 0.55 * self.colour(i) + 0.15)
+                                 self.ink(i, 0.55, 0.15))
 
     @ti.kernel
     def draw_spring_coils(self):
@@ -224,7 +249,7 @@ class Canvas(runtime.Launcher):
                 if ti.static(self.links[j] == "spring"):
                     a, b = self.joint(i, j), self.pos[i, j]
                     self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
-                                 self.lw, 0.55 * self.colour(i) + 0.15)
+                                 self.lw, self.ink(i, 0.55, 0.15))
 
     @ti.func
     def coil_node(self, a, b, k):
@@ -248,7 +273,7 @@ class Canvas(runtime.Launcher):
         ti.loop_config(serialize=self.serial)
         for i in range(self.n):
             for j in ti.static(range(len(self.links))):
-                self.disc(self.pos[i, j], self.radii[j], self.colour(i))
+                self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0))
         self.disc(ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
 
     @ti.kernel
@@ -264,14 +289,23 @@ class Canvas(runtime.Launcher):
             if ti.static(self.trails):
                 lit = self.lit[ty, tx]
                 if drawn and lit:  # one branch per tile, so each pixel loop is straight-line code
-                    self.lit[ty, tx] = self.compose_tile(out, ty, tx, True, True)
+                    self.lit[ty, tx] = self.tile(out, ty, tx, True, True)
                 elif lit:
-                    self.lit[ty, tx] = self.compose_tile(out, ty, tx, False, True)
+                    self.lit[ty, tx] = self.tile(out, ty, tx, False, True)
                 elif drawn:
-                    self.compose_tile(out, ty, tx, True, False)
+                    self.tile(out, ty, tx, True, False)
             elif drawn:
-                self.compose_tile(out, ty, tx, True, False)
+                self.tile(out, ty, tx, True, False)
             self.drawn[ty, tx] = 0
+
+    @ti.func
+    def tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
+        lit = 0
+        if ti.static(not self.glowing):
+            lit = self.compose_tile(out, ty, tx, layer, trail)
+        else:
+            lit = self.glow.compose_tile(self, out, ty, tx, layer, trail)
+        return lit
 
     @ti.func
     def compose_tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
@@ -297,12 +331,3 @@ class Canvas(runtime.Launcher):
                 for k in ti.static(range(3)):
                     out[y, x, k] = to_byte(c[k])
         return lit
-
-    @ti.kernel
-    def fractal_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
-        """One pendulum per pixel: the two angles mapped to colour."""
-        for y, x in ti.ndrange(self.h, self.w):
-            q = self.sim.q[y * self.w + x]
-            c = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
-            for k in ti.static(range(3)):
-                out[y, x, k] = ti.cast(c[k] * 255.0 + 0.5, ti.u8)

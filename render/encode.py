@@ -65,6 +65,17 @@ def gif_args(video) -> list[str]:
 ARGS = {"mp4": mp4_args, "gif": gif_args}
 
 
+class _Still:
+    """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
+
+    def __init__(self, final: Path):
+        self.final, self.tmp, self.frame = final, temp_beside(final, suffix=".part"), None
+
+    def finish(self):
+        import imageio.v3 as iio
+        iio.imwrite(self.tmp, self.frame, extension=".png")
+
+
 class _Target:
     """One ffmpeg process, the thread that feeds it, and where its output goes."""
 
@@ -103,10 +114,14 @@ class Encoder:
 
     def __init__(self, out_dir: Path, name: str, video, formats=None):
         self.targets: list[_Target] = []
+        self.stills: list[_Still] = []
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         try:
             for fmt in formats or video.formats:
                 final = out_dir / f"{name}.{fmt}"
+                if fmt == "png":
+                    self.stills.append(_Still(final))
+                    continue
                 tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
@@ -148,6 +163,8 @@ class Encoder:
                 raise EncodeError(f"ffmpeg stopped: {self._logs() or t.error}")
         for t in self.targets:
             t.queue.put(frame)
+        for s in self.stills:
+            s.frame = frame  # shared like the queues' frames: only the last one is kept
 
     def close(self) -> dict[str, int]:
         """Finish encoding and rename into place; returns file name -> bytes."""
@@ -165,12 +182,19 @@ class Encoder:
             msg = self._logs() or str(errors[0] if errors else f"exit status {max(codes)}")
             self.abort()
             raise EncodeError(f"ffmpeg failed: {msg}")
+        try:
+            for s in self.stills:
+                s.finish()
+        except BaseException:
+            self.abort()
+            raise
         sizes = {}
-        for t in self.targets:
+        for t in [*self.targets, *self.stills]:
             publish(t.tmp, t.final)
             sizes[t.final.name] = t.final.stat().st_size
+        for t in self.targets:
             t.log.close()
-        self.targets = []
+        self.targets, self.stills = [], []
         return sizes
 
     def abort(self):
@@ -187,7 +211,9 @@ class Encoder:
             t.thread.join(timeout=5)
             t.tmp.unlink(missing_ok=True)
             t.log.close()
-        self.targets = []
+        for s in self.stills:
+            s.tmp.unlink(missing_ok=True)
+        self.targets, self.stills = [], []
 
     def _logs(self) -> str:
         out = []

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, certify, quality, registry, runtime
+from . import __version__, certify, grid, quality, registry, runtime
 from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
 
@@ -25,7 +25,8 @@ def prepare(scene, arch: str, threads: int | None):
     t = time.perf_counter()
     scene, chosen = quality.choose(scene, arch, threads)
     t_quality = time.perf_counter() - t
-    cert = certify.certify(scene, arch, threads)
+    # A map certifies the lattice its trust mask is read from (render/grid.py), not 128 pixels in row order.
+    cert = certify.certify(scene, arch, threads, grid.trust_indices(scene) if scene.fractal else None)
     timings = {"quality": t_quality, "certify": cert.cost_s} if scene.quality else {"certify": cert.cost_s}
     return scene, chosen, cert, timings
 
@@ -36,13 +37,15 @@ def progress_bar(total: int, desc: str, enabled: bool):
                 dynamic_ncols=True)
 
 
-def frames(scene, sim, timings: dict):
-    """Yield each frame index with the simulation at that frame's time (frame 0 is t=0), watchdog checked."""
+def frames(scene, sim, timings: dict, advance=None):
+    """Yield each frame index with the simulation at that frame's time (frame 0 is t=0), watchdog checked.
+    `advance` moves it one frame on (default: sim.advance_frame; a map stops pixels at their events)."""
+    advance = advance or sim.advance_frame
     max_drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
     for f in range(scene.frames):
         t = time.perf_counter()
         if f:
-            sim.advance_frame()
+            advance()
         if scene.has("energy"):
             sim.measure_energy(first=f == 0)
         sim.check(f, max_drift)
@@ -74,12 +77,16 @@ class Source:
     """
 
     def __init__(self, scene, arch: str = "cpu", threads: int | None = None):
-        from .canvas import Canvas
-
         self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
         self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
         self.sim = make_system(self.scene)
-        self.canvas = Canvas(self.scene, self.sim)
+        if self.scene.fractal:
+            from .fractal import Map
+            self.canvas = Map(self.scene, self.sim, self.cert)  # it advances the pixels too: events per substep
+        else:
+            from .canvas import Canvas
+            from .hud import Info
+            self.canvas = Canvas(self.scene, self.sim, Info.of(self.scene, self.sim.h, self.cert))
         self.name, self.frames = self.scene.name, self.scene.frames
         self.timings = {**before, "simulate": 0.0, "draw": 0.0}
         self.reset(rewind=False)
@@ -88,14 +95,15 @@ class Source:
         if rewind:
             self.sim.restart()
             self.canvas.restart()
-        self._steps = frames(self.scene, self.sim, self.timings)  # frame 0 measures the energy afresh
+        self._steps = frames(self.scene, self.sim, self.timings,  # frame 0 measures the energy afresh
+                             getattr(self.canvas, "advance_frame", None))
         self.index = -1
 
     def next_frame(self, out: np.ndarray | None = None) -> np.ndarray:
         """The next frame as H×W×3 uint8, written into `out` if given (else a new array)."""
         self.index = next(self._steps)
         t = time.perf_counter()
-        frame = self.canvas.draw(out)
+        frame = self.canvas.draw(out, self.index / self.scene.video.fps)
         self.timings["draw"] += time.perf_counter() - t
         return frame
 
@@ -130,6 +138,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
         timings["total"] = time.perf_counter() - t_start
         meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen,
                         {f: digest(out_dir / f) for f in sizes})
+        if scene.fractal:
+            meta["map"] = src.canvas.summary()
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 

@@ -96,9 +96,18 @@ class Launcher:
 allocated: dict[str, int] = {}  # field name -> bytes, since the last init
 
 
-def field(name: str, dtype, shape, n: int | None = None):
-    """Allocate a (vector) field and account for its bytes, so a run can show what it allocated."""
-    f = ti.field(dtype, shape) if n is None else ti.Vector.field(n, dtype, shape)
+def field(name: str, dtype, shape, n: int | None = None, block: int | None = None):
+    """Allocate a (vector) field and account for its bytes, so a run can show what it allocated.
+
+    block: a 2-D field stored as block×block tiles, each contiguous (its shape rounded up to whole tiles),
+    so that a walk along either axis stays in a few cache lines."""
+    if block is None:
+        f = ti.field(dtype, shape) if n is None else ti.Vector.field(n, dtype, shape)
+    else:
+        f = ti.field(dtype) if n is None else ti.Vector.field(n, dtype)
+        tiles = tuple(-(-s // block) for s in shape)
+        ti.root.dense(ti.ij, tiles).dense(ti.ij, (block, block)).place(f)
+        shape = tuple(t * block for t in tiles)
     count = 1
     for s in (shape if isinstance(shape, tuple) else (shape,)):
         count *= s

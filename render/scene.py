@@ -15,15 +15,16 @@ from pathlib import Path
 from . import keys, registry
 from .errors import SceneError
 from .quality import check_level
-from .validate import (EFFECTS, FORMATS, LAYOUTS, LINK_EFFECTS, MAX_PENDULUMS, MAX_PIXELS,  # noqa: F401
-                       METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
+from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
+                       MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
 
 PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
 FAN_KEYS = {"gap": "spread", "spread": "gap"}
-COMMON_PENDULUM_KEYS = {"count": REQUIRED, "layout": "fan", "spread": 1e-4, "gap": None, "gravity": 9.8,
+# A grid derives its count from the frame (render/grid.py): one pendulum per pixel of the plot.
+COMMON_PENDULUM_KEYS = {"count": None, "layout": "fan", "spread": 1e-4, "gap": None, "gravity": 9.8,
                         "damping": 0.0}
 
 
@@ -43,6 +44,7 @@ SCHEMA: dict[str, object] = {
     "system": REQUIRED,
     "effects": None,
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
+    "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64", "trig": "inline",
@@ -50,8 +52,9 @@ SCHEMA: dict[str, object] = {
     },
     "video": {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
-        "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20,
+        "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20, "palette": "fan",
     },
+    "map": dict(MAP_DEFAULTS),  # fractal maps only
 }
 
 
@@ -98,6 +101,14 @@ class Video:
     trail_seconds: float
     gif_width: int
     gif_fps: int
+    palette: str = "fan"
+
+
+@dataclasses.dataclass(frozen=True)
+class MapSpec:
+    epsilon: float
+    threshold: float
+    trust_stride: int
 
 
 @dataclasses.dataclass(frozen=True)
@@ -110,6 +121,8 @@ class Scene:
     integrator: Integrator
     video: Video
     quality: str | None = None
+    fractal: str | None = None  # a map's colouring, None for a fan
+    map: MapSpec | None = None
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -137,6 +150,8 @@ class Scene:
     def replace(self, **sections) -> "Scene":
         """A copy with whole sections or fields swapped, e.g. replace(integrator={...})."""
         d = self.to_dict()
+        if d["pendulums"]["layout"] == "grid" and "count" not in sections.get("pendulums", {}):
+            del d["pendulums"]["count"]  # derived again from the (new) frame
         for k, v in sections.items():
             if isinstance(v, dict):
                 d[k].update(v)
@@ -236,7 +251,8 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
     d = v.build(v.merge(raw, schema, ""))
     return Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
-                 Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], source=src)
+                 Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
+                 source=src)
 
 
 def _display(path: Path) -> str:

@@ -13,7 +13,7 @@ contract (LINKS, bob_sizes(), reach(), lengths).
 import numpy as np
 import taichi as ti
 
-from . import budget, integrators, keys, runtime
+from . import budget, grid, integrators, keys, runtime
 from .sincos import sincos
 from .errors import SimulationError
 
@@ -130,14 +130,13 @@ class System(runtime.Launcher):
     def initial_angles(self) -> tuple[np.ndarray, np.ndarray]:
         """Per pendulum, the angle and rate of every link, each (N, links).
 
-        A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]²."""
+        A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]², one
+        per pixel of the map's plot (render/grid.py)."""
         p, n, links = self.scene.pendulums, self.count, len(self.LINKS)
         th = np.array([[p[f"theta{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         if p.layout == "grid":
-            wd, ht = self.scene.video.width, self.scene.video.height
-            th[:, 0] = np.tile(np.linspace(-np.pi, np.pi, wd), ht)
-            th[:, 1] = np.repeat(np.linspace(np.pi, -np.pi, ht), wd)  # row 0 at the top of the frame
+            th, w = grid.grid_state(self.scene, th, w)
         else:
             th[:, -1] = th[:, -1] - p.spread * np.arange(n, dtype=np.float64) / n
         return th, w

@@ -13,18 +13,27 @@ import difflib
 import math
 import re
 
-from . import keys, registry
+from . import grid, keys, registry
 from .errors import SceneError
 from .quality import LEVELS
 
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
-TRIGS = ("inline", "libm")
-FORMATS = ("mp4", "gif")
+TRIGS = ("inline", "libm")  # integrator.trig: render/sincos.py, or the C library's (bit for bit as the seed)
+FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
 LAYOUTS = ("fan", "grid")
+FRACTALS = ("angles", "flip_time", "divergence")  # how a map (effects = ["fractal"]) colours its pixels
+MAP_DEFAULTS = {  # [map]: fractal maps only
+    "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
+    "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
+    "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
+}
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal")
+# New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow")
+DRAWN = ("rods", "springs", "bobs", "trails")  # effects that draw the pendulums (glow composes these)
+PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/canvas.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
 MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
 MAX_PIXELS = 3840 * 2160
@@ -145,7 +154,8 @@ class Validator:
         description = self.text(d["description"], "description", DESCRIPTION_MAX)
         system = self.choice(d["system"], "system", SYSTEMS)
         video = self.video(d)
-        pend = self.pendulums(d, system, video)
+        fractal = self.fractal(d, system)
+        pend = self.pendulums(d, system, video, fractal)
         integ = self.integrator(d, system)
         if integ["precision"] == "f32":
             for key in ("lengths", "masses"):
@@ -156,8 +166,33 @@ class Validator:
         quality = d["quality"]
         if quality is not None:
             self.choice(quality, "quality", LEVELS)
+        effects = self.effects(d, system, pend, fractal)
+        if "fractal" in effects and fractal is None:
+            fractal = "angles"
         return {"name": name, "description": description, "system": system, "quality": quality,
-                "effects": self.effects(d, system, pend), "pendulums": pend, "integrator": integ, "video": video}
+                "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
+                "fractal": fractal, "map": self.map(d, fractal)}
+
+    def fractal(self, d, system) -> str | None:
+        val = d["fractal"]
+        if val is None:
+            return None
+        self.choice(val, "fractal", FRACTALS)
+        if not registry.get(system).ANGLES:
+            self.fail("fractal", f"{val!r} colours pixels by link angles, and this system's state is not angles "
+                      f"(systems with angles: {', '.join(n for n in SYSTEMS if registry.get(n).ANGLES)})")
+        return val
+
+    def map(self, d, fractal) -> dict:
+        given = self.given.get("map") or {}
+        changed = [k for k, val in given.items() if val != MAP_DEFAULTS.get(k)]  # (a fan's own dict round trips)
+        if fractal is None and changed:
+            self.fail(f"map.{changed[0]}", "only a fractal map (effects = [\"fractal\"]) has this key")
+        eps = self.real(d, "map", "epsilon", 0.0, 1.0, lo_open=True)
+        thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
+        if fractal == "divergence" and thr <= eps:
+            self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
+        return {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096)}
 
     def video(self, d) -> dict:
         w = self.integer(d, "video", "width", 16, 7680)
@@ -177,15 +212,24 @@ class Validator:
         if gw % 2:
             self.fail("video.gif_width", f"must be even, got {gw}")
         gfps = self.integer(d, "video", "gif_fps", 1, 50)
+        palette = self.choice(d["video"]["palette"], "video.palette", PALETTES)
         return {"width": w, "height": h, "fps": fps, "duration": dur, "formats": formats, "trail_seconds": trail,
-                "gif_width": gw, "gif_fps": gfps}
+                "gif_width": gw, "gif_fps": gfps, "palette": palette}
 
-    def pendulums(self, d, system, video) -> dict:
+    def pendulums(self, d, system, video, fractal) -> dict:
         layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
+        if layout == "grid":
+            want = grid.pendulums(video["width"], video["height"], fractal)
+            if d["pendulums"]["count"] is None:
+                d["pendulums"]["count"] = want
+            lay = grid.layout(video["width"], video["height"])
+            if d["pendulums"]["count"] != want:
+                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video['width']}x"
+                          f"{video['height']} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+        elif d["pendulums"]["count"] is None:
+            self.fail("pendulums.count", "missing (this key is required)")
         count = self.integer(d, "pendulums", "count", 1, MAX_PENDULUMS)
-        if layout == "grid" and count != video["width"] * video["height"]:
-            self.fail("pendulums.count", f"a grid layout has one pendulum per pixel: "
-                      f"{video['width']}x{video['height']} = {video['width'] * video['height']}, got {count}")
         out = {"count": count, "layout": layout}
         out.update({k: self.declared(d, "pendulums", k, spec)
                     for k, spec in registry.get(system).preset_keys().items()})
@@ -223,10 +267,14 @@ class Validator:
         return {"method": method, "dt": dt, "precision": prec, "trig": trig, "allow_unstable": allow,
                 "max_drift": drift, "tolerance": tol, "min_faithful": least}
 
-    def effects(self, d, system, pend) -> tuple[str, ...]:
+    def effects(self, d, system, pend, fractal) -> tuple[str, ...]:
         given = d["effects"]
         cls = registry.get(system)
+        if given is None and fractal is not None:
+            given = ["fractal"]  # a colouring names a map
         eff = list(cls.DEFAULT_EFFECTS if given is None else self.strings(given, "effects", EFFECTS))
+        if fractal is not None and "fractal" not in eff:
+            self.fail("fractal", f"colours a map, and effects = {eff} draws none: use effects = [\"fractal\"]")
         if pend["damping"] > 0 and "damping" not in eff:
             eff.append("damping")  # a damped scene always simulates its damping
         if "damping" in eff and pend["damping"] == 0:
@@ -243,11 +291,13 @@ class Validator:
                           + ")")
             if pend["layout"] != "grid":
                 self.fail("effects", "'fractal' colours one pendulum per pixel and needs pendulums.layout = \"grid\"")
-            clash = [e for e in eff if e in ("rods", "springs", "bobs", "trails")]
+            clash = [e for e in eff if e in DRAWN + ("hud", "glow")]
             if clash:
                 self.fail("effects", f"'fractal' fills every pixel; it cannot be combined with {clash}")
         elif pend["layout"] == "grid":
             self.fail("pendulums.layout", "a grid of pendulums is drawn with effects = [\"fractal\"]")
+        if "glow" in eff and not any(e in eff for e in DRAWN):
+            self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
 
 

@@ -80,8 +80,33 @@ def test_damping_is_simulated_only_when_called_for(tmp_path):
     assert (sim.e.to_numpy() < sim.e0.to_numpy()).all()
 
 
-@pytest.mark.parametrize("effects", [["springs"], ["fractal"], ["rods", "fractal"]])
+@pytest.mark.parametrize("effects", [["springs"], ["fractal"], ["rods", "fractal"], ["fractal", "hud"],
+                                     ["fractal", "glow"]])
 def test_invalid_combinations_are_bad_input(effects):
     from render.scene import SceneError
     with pytest.raises(SceneError, match="effects"):
+        make_scene("rigid", 2, effects=effects, pendulums=PEND, video=VIDEO)
+
+
+def hud_work(names):
+    return [n for n in names if n.startswith(("hud", "font", "text_"))]
+
+
+def test_the_hud_is_only_paid_for_when_asked_and_only_adds_light(tmp_path):
+    base, without = render(tmp_path, effects=("rods", "bobs"))
+    assert hud_work(base["kernels"]) == [] and hud_work(base["fields"]) == []
+    more, with_hud = render(tmp_path, effects=("rods", "bobs", "hud"))
+    added = [k for k in more["kernels"] if k not in base["kernels"]]
+    assert sorted(added) == ["hud_graph", "text_bytes"], added
+    new_fields = set(more["fields"]) - set(base["fields"])
+    assert new_fields == {"hud.spread", "hud.history", "font.glyphs"}, new_fields
+    assert more["field_bytes"] - base["field_bytes"] == sum(more["fields"][f] for f in new_fields)
+    # drawn over the finished frame with a max: the pendulums are all still there, and text was added
+    assert (with_hud >= without).all() and (with_hud > without).any()
+
+
+@pytest.mark.parametrize("effects", [["glow"], ["energy", "glow"]])
+def test_glow_without_anything_drawn_is_bad_input(effects):
+    from render.scene import SceneError
+    with pytest.raises(SceneError, match="effects: 'glow'"):
         make_scene("rigid", 2, effects=effects, pendulums=PEND, video=VIDEO)

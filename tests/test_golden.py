@@ -25,8 +25,6 @@ PRESETS = [p.stem for p in list_presets()]
 def small_scene(name):
     sets = [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", f"video.duration={SECONDS}",
             'video.formats=["mp4"]']
-    if load(name).pendulums.layout == "grid":
-        sets.append(f"pendulums.count={W * H}")
     return load(name, sets)
 
 

@@ -88,11 +88,12 @@ def test_no_module_outside_the_systems_and_the_registry_names_a_system():
     assert not offenders, offenders
 
 
-def test_the_canvas_reads_only_the_drawing_contract():
-    """The canvas never reaches into a system's private fields (sim.m1, sim.l1, ...)."""
+@pytest.mark.parametrize("module", ["canvas.py", "hud.py"])
+def test_the_canvas_reads_only_the_drawing_contract(module):
+    """The canvas (and the HUD it draws) never reaches into a system's private fields (sim.m1, sim.l1, ...)."""
     contract = {"points", "q", "n", "LINKS", "reach", "bob_sizes", "lengths"}
     used = set()
-    for node in ast.walk(ast.parse((PKG / "canvas.py").read_text())):
+    for node in ast.walk(ast.parse((PKG / module).read_text())):
         if isinstance(node, ast.Attribute):
             owner = node.value
             if (isinstance(owner, ast.Name) and owner.id == "sim") or (

@@ -18,8 +18,6 @@ MIN_PSNR_GIF = 18.0  # dB, after downscaling the raw frame to the GIF's size (25
 
 def short(name, **extra):
     sets = [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", f"video.duration={SECONDS}"]
-    if load(name).pendulums.layout == "grid":  # one pendulum per pixel
-        sets.append(f"pendulums.count={W * H}")
     return load(name, sets + [f"{k}={v}" for k, v in extra.items()])
 
 

@@ -54,9 +54,30 @@ class Elastic(System):
         vx2, vy2 = vx1 + l2 * w2 * np.cos(th2), vy1 + l2 * w2 * np.sin(th2)
         return np.stack([x1, y1, x2, y2], 1), np.stack([vx1, vy1, vx2, vy2], 1)
 
+    def initial_energy(self) -> float:
+        """The largest energy of any pendulum at t = 0 (as energy() computes it; damping only lowers it)."""
+        q, v = self.initial_state()
+        x1, y1, x2, y2 = q.T
+        s1, s2 = np.hypot(x1, y1) - self.l1, np.hypot(x2 - x1, y2 - y1) - self.l2
+        kin = 0.5 * self.m1 * (v[:, 0] ** 2 + v[:, 1] ** 2) + 0.5 * self.m2 * (v[:, 2] ** 2 + v[:, 3] ** 2)
+        grav = self.m1 * self.g * (y1 + self.l1) + self.m2 * self.g * (y2 + self.l1 + self.l2)
+        return float(np.max(kin + 0.5 * self.k1 * s1 ** 2 + 0.5 * self.k2 * s2 ** 2 + grav))
+
     def reach(self) -> float:
-        """Reach of the outer bob: rest lengths plus the largest stretch energy allows (bounded)."""
-        return (self.l1 + self.l2) * 1.15
+        """How far from the pivot either bob can ever get, from the energy: nothing leaves the frame.
+
+        With stretches s1, s2 the outer bob is at most l1 + s1 + l2 + s2 from the pivot, and each bob is at
+        most that far below it, so the potential is at least
+            f(s1, s2) = ½k1·s1² − (m1 + m2)·g·s1 + ½k2·s2² − m2·g·s2
+        (gravity measured as energy() does, zero at the rest lengths hanging). Kinetic energy is never
+        negative, so every state reached has f ≤ E, the largest initial energy. On that ellipse,
+        ½k1(s1 − a/k1)² + ½k2(s2 − b/k2)² ≤ C with a = (m1 + m2)g, b = m2·g, C = E + a²/2k1 + b²/2k2,
+        the largest s1 + s2 is a/k1 + b/k2 + √(2C(1/k1 + 1/k2)) (Cauchy-Schwarz). The inner bob's bound,
+        l1 + a/k1 + √(2C/k1), is smaller, so this one frames both."""
+        a, b = (self.m1 + self.m2) * self.g, self.m2 * self.g
+        c = max(self.initial_energy(), 0.0) + a * a / (2 * self.k1) + b * b / (2 * self.k2)
+        stretch = a / self.k1 + b / self.k2 + math.sqrt(2 * c * (1 / self.k1 + 1 / self.k2))
+        return self.l1 + self.l2 + stretch
 
     @ti.func
     def spring_pull(self, dx, dy, k, rest):

@@ -1,0 +1,95 @@
+"""The HUD: the clock says the simulated time and changes colour past the certificate's marks, the spread is
+the largest distance between neighbours' last bobs, it works for every system, and it stays in its corners."""
+import numpy as np
+import pytest
+
+from render import hud, pipeline, runtime
+from render.scene import load
+
+W, H, FPS = 256, 144, 10
+
+
+def run(name, info=None, upto=None, sets=()):
+    """Draw a preset's frames with the HUD on (small, short); returns the canvas, the frames and the system."""
+    scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", "video.duration=0.5",
+                        'effects=["bobs", "hud"]', *sets])
+    runtime.init("cpu", scene.integrator.precision)
+    from render.canvas import Canvas
+
+    sim = pipeline.make_system(scene)
+    canvas = Canvas(scene, sim, info)
+    frames = []
+    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        frames.append(canvas.draw(t=f / FPS).copy())
+        if f == upto:
+            break
+    return canvas, np.stack(frames), sim
+
+
+def expected_text(canvas, text, colour, x, y, size, scale):
+    img = np.zeros((H, W, 3), np.uint8)
+    canvas.hud.font.draw(img, text, x, y, colour, scale, size=size)
+    return img
+
+
+def tip_positions(name, q):
+    """The last bob of every pendulum, from the state, computed here (not with the system's own points())."""
+    p = load(name).pendulums
+    if q.shape[1] == 4:  # springs: q holds the bobs' positions
+        return q[:, 2:4]
+    return np.stack([sum(l * np.sin(q[:, k]) for k, l in enumerate(p.lengths)),
+                     sum(-l * np.cos(q[:, k]) for k, l in enumerate(p.lengths))], 1)
+
+
+@pytest.mark.parametrize("name", ["rigid_chaos", "elastic_fan", "triple_chaos"])
+def test_every_system_gets_a_clock_and_its_fans_spread(name):
+    canvas, frames, sim = run(name)
+    h = canvas.hud
+    small, big, _ = hud.faces(H)
+    box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]  # the clock's cells at 256x144 (6x13)
+    want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *big)
+    np.testing.assert_array_equal(frames[-1][box], want[box])
+    tips = tip_positions(name, sim.q.to_numpy())
+    spread = np.hypot(*np.diff(tips, axis=0).T).max()
+    assert float(h.spread[None]) == pytest.approx(spread, rel=1e-6)
+    assert h.history.to_numpy()[4] == pytest.approx(np.log10(spread / sim.reach()), abs=1e-5)
+
+
+def test_the_clock_turns_amber_then_red_past_the_certificates_marks_and_the_timeline_has_ticks():
+    info = hud.Info("a caption", "rk4", 1e-3, "f64", faithful_until_s=0.15, median_until_s=0.25)
+    canvas, frames, _ = run("rigid_chaos", info)
+    h = canvas.hud
+    box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]
+    byte = lambda c: tuple(int(np.floor(v * 255 + 0.5)) for v in c)  # noqa: E731
+    for f, colour in ((0, hud.WHITE), (1, hud.WHITE), (2, hud.AMBER), (3, hud.RED), (4, hud.RED)):  # t = 0 ... 0.4
+        lit = frames[f][box].reshape(-1, 3)
+        lit = {tuple(p) for p in lit[lit.max(1) > 0]}
+        assert lit == {byte(colour)}, (f, lit)
+    below_axis = frames[-1][h.gy1 + 3 * h.th]
+    assert tuple(below_axis[h.x_of(0.15)]) == byte(hud.AMBER)
+    assert tuple(below_axis[h.x_of(0.25)]) == byte(hud.RED)
+    assert below_axis[h.x_of(0.15) + 1:h.x_of(0.25)].max() == 0
+
+
+def test_a_long_caption_is_cut_to_its_strip_and_nothing_leaves_the_corners():
+    long = "x" * 300
+    canvas, frames, _ = run("rigid_chaos", hud.Info(long, "rk4", 1e-3, "f64"), upto=0)
+    _, plain, _ = run("rigid_chaos", upto=0, sets=['effects=["bobs"]'])
+    added = (frames[0] != plain[0]).any(2)
+    h = canvas.hud
+    rows, cols = np.nonzero(added)
+    assert cols.max() <= W - h.m - 1 and rows.max() <= H - h.m
+    strip = added[H - h.m - 13:H - h.m]
+    caption_cols = np.nonzero(strip[:, h.gx1 + 1:].any(0))[0] + h.gx1 + 1
+    assert caption_cols.min() > h.gx1 and caption_cols.max() >= W - h.m - 6  # cut, up to its last cell
+    assert added.mean() < 0.1  # the HUD is a frame around the picture, not over it
+
+
+def test_a_single_pendulum_has_a_clock_and_a_timeline_but_no_spread():
+    canvas, frames, _ = run("classic")
+    h = canvas.hud
+    assert not h.fan and not hasattr(h, "spread")
+    box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]
+    want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *hud.faces(H)[1])
+    np.testing.assert_array_equal(frames[-1][box], want[box])
+    assert frames[-1][h.gy1 + 1, h.gx0:h.x_of(0.4)].min() > 0  # the timeline, lit up to now
