@@ -8,23 +8,26 @@ and those calls were 93 % of the rigid kernel's time. These are plain arithmetic
 Method: j = round(x·2/π), r = x − j·π/2 with π/2 split Cody-Waite style (P1 has 33 significant bits, so
 j·P1 is exact for |j| < 2^20, |x| < 1.6e6), then sin and cos of r ∈ [−π/4, π/4] by fdlibm's minimax
 polynomials (__kernel_sin / __kernel_cos, degree 13 / 14) in f64, Cephes' sinf / cosf (degree 7 / 8) in
-f32; the quadrant j mod 4 swaps and negates with ti.select. `sincos` picks the form at compile time from
+f32 (their tails in f32, the leading terms in f64); the quadrant j mod 4 swaps and negates with ti.select. `sincos` picks the form at compile time from
 the runtime's settings:
   f64, fast_math (the project's setting)  -> sincos_f64: a reassociation-proof 2- or 3-part reduction;
   f64 without fast_math                   -> sincos_f64_precise: fdlibm's double-double reduction;
-  f32                                      -> sincos_f32: the reduction in f64, the polynomials in f32.
+  f32                                      -> sincos_f32: the reduction and the leading terms in f64.
 
 fast_math gives every float op LLVM's `reassoc nsz` flags, and LLVM then rewrites x − j·P1 − j·P2 as
 x − j·(P1 + P2): the split is folded away and the result is off by up to 1e-5 rad at |x| = 1e5. So the
 later parts are multiplied by copies of j re-made from the integer quadrant (float(k), float(−k)), which
 LLVM does not prove equal to ±j. A reduction in f32 alone (π/2 in 8 + 8 + 24 bits) was 30 % faster in the
-f32 kernel but up to 1e7 ulp wrong (478 ulp already at |x| <= 512): not used.
+f32 kernel but up to 1e7 ulp wrong (478 ulp already at |x| <= 512): not used. Cephes' polynomials wholly in
+f32 (after the f64 reduction) give 1.57 ulp and the rigid f32 kernel 50M steps/s instead of 36M, but an f32
+flip map then parted from DOP853 where its trust mask vouched for it (tests/test_fractal.py): the f32 form
+here is as close to libm's sinf (0.56 ulp) as the f64 leading terms make it.
 
 Measured error (ulp of the exact result; f64 against mpmath at 150 bits, f32 against libm's f64 result):
   sincos_f64 (fast_math on or off): 1.56 ulp on |x| <= 1e5, 0.60 ulp on the doubles nearest k·π/2;
   sincos_f64_precise (fast_math off): 0.77 ulp; (with fast_math on it is wrong: `sincos` never uses it so);
-  sincos_f32: 1.57 ulp over every normal float with |x| <= 1e5.
-tests/test_sincos.py holds them to 2 ulp against numpy. Beyond |x| = 1.6e6 the reduction degrades slowly;
+  sincos_f32: 0.76 ulp (measured on 1.6e5 floats to |x| <= 1e5 and near k·π/2).
+tests/test_sincos.py holds f64 to 2 ulp and f32 to 1 ulp of the exact value. Beyond |x| = 1.6e6 the reduction degrades slowly;
 |x| > 1e9 (where the i32 quadrant would overflow), NaN and ±inf give NaN. Subnormal inputs are flushed to
 0 by Taichi's CPU runtime, so sin(1e-310) = 0.
 """
@@ -79,14 +82,6 @@ def _poly_f64(r):
 
 
 @ti.func
-def _poly_f32(r):
-    z = r * r
-    s = r + r * z * (FS1 + z * (FS2 + z * FS3))
-    c = 1.0 - 0.5 * z + z * z * (FC1 + z * (FC2 + z * FC3))
-    return s, c
-
-
-@ti.func
 def sincos_f64(x):
     """f64, safe under fast_math. r = (x − j·P1) + j''·P1T (π/2 to 86 bits); where that leaves |r| < 2^-12
     (deep cancellation near a multiple of π/2) r = ((x − j·P1) − j'·P2) + j''·P2T (119 bits) instead.
@@ -129,12 +124,19 @@ def sincos_f64_precise(x):
 
 @ti.func
 def sincos_f32(x):
-    """f32 result; x widened to f64 for the reduction (3 f64 ops), so r is right to 0.5 ulp at any |x| < 1.6e6."""
+    """f32 result; x widened to f64 for the reduction (3 f64 ops), so r is right at any |x| < 1.6e6. The
+    polynomials' tails run in f32 (8 lanes to a ymm register); sin = r + r·tail and cos = 1 − r²/2 + tail in
+    f64, rounded once to f32, so their rounding errors shrink with the tails (a few % of the result)."""
     xd = ti.cast(x, ti.f64)
     j = ti.round(xd * ti.f64(TWO_OVER_PI))
     k = ti.cast(j, ti.i32)
-    r = ti.cast((xd - j * ti.f64(P1)) - ti.cast(k, ti.f64) * ti.f64(P1T), ti.f32)
-    s, c = _poly_f32(r)
+    r = (xd - j * ti.f64(P1)) - ti.cast(k, ti.f64) * ti.f64(P1T)
+    rf = ti.cast(r, ti.f32)
+    zf = rf * rf
+    ps = zf * (FS1 + zf * (FS2 + zf * FS3))  # the polynomials' tails in f32: their rounding is scaled down
+    pc = zf * zf * (FC1 + zf * (FC2 + zf * FC3))
+    s = ti.cast(r + r * ti.cast(ps, ti.f64), ti.f32)  # the leading terms in f64, rounded once
+    c = ti.cast((1.0 - 0.5 * r * r) + ti.cast(pc, ti.f64), ti.f32)
     sn, cs = _quadrant(k, s, c)
     return _guard(x, sn, cs)
 

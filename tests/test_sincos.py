@@ -66,9 +66,10 @@ def ulp_error(got: np.ndarray, exact: np.ndarray, dtype) -> np.ndarray:
 
 
 @pytest.mark.parametrize("precision", ["f64", "f32"])
-def test_sincos_is_within_2_ulp_of_the_exact_value(precision):
+def test_sincos_is_within_2_ulp_in_f64_and_1_in_f32_of_the_exact_value(precision):
     runtime.init("cpu", precision)  # the project's settings (fast_math on), so the form the kernels use
     dtype = np.float64 if precision == "f64" else np.float32
+    bound = 2.0 if precision == "f64" else 1.0  # measured: 1.56 and 0.76
     x = arguments(dtype)
     x = x[: len(x) // LANES * LANES]
     exact = x.astype(np.longdouble)
@@ -77,8 +78,8 @@ def test_sincos_is_within_2_ulp_of_the_exact_value(precision):
         s, c = np.empty_like(x), np.empty_like(x)
         kernel(x, s, c)
         es, ec = ulp_error(s, exact_s, dtype), ulp_error(c, exact_c, dtype)
-        assert es.max() <= 2.0, (precision, kernel.__name__, x[es.argmax()], es.max())
-        assert ec.max() <= 2.0, (precision, kernel.__name__, x[ec.argmax()], ec.max())
+        assert es.max() <= bound, (precision, kernel.__name__, x[es.argmax()], es.max())
+        assert ec.max() <= bound, (precision, kernel.__name__, x[ec.argmax()], ec.max())
         # where the answer is exact it is given exactly
         zero = x == 0
         assert (s[zero] == 0).all() and (c[zero] == 1).all()
