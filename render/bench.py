@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import math
 import os
 import platform
 import subprocess
@@ -41,6 +42,9 @@ TARGETS = [("end_to_end_over_encode_floor", "<=", 1.3), ("sim_speedup_vs_numpy_1
            ("render_over_realtime", "<=", 1.0), ("matplotlib_peer_ratio", ">=", 12.0)]
 
 
+LOAD_AT_START: list[float] = [math.nan] * 3
+
+
 def add_parser(sub):
     p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal",
                        description="Measure simulation throughput (Taichi vs numpy), drawing and encoding fps, "
@@ -61,6 +65,7 @@ def run(args) -> int:
         args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
         return 0
     check_writable(args.out)
+    LOAD_AT_START[:] = os.getloadavg()  # other work on the machine skews every figure: the report says how much
     t0, res = time.perf_counter(), {}
     with tempfile.TemporaryDirectory(prefix="pendulum-bench-") as tmp:
         for name in PHASES:
@@ -70,6 +75,11 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
     write_atomic(args.out / "report.md", markdown(report).encode())
+    m = report["machine"]
+    write_atomic(args.out / "targets.md", "\n".join(  # for the README (benchmarks/readme_figures.py)
+        targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
+                                 f"{m['cpus']} CPUs ({m['cpu']}), load average {m['load_avg'][0]:.2f} at the start, "
+                                 f"numba {report['peers']['numba']}."]).encode() + b"\n")
     for key, t in report["targets"].items():
         print(f"{key} = {fmt(t['value'])} (target {t['goal']}): "
               f"{'met' if t['met'] else 'not measured' if t['met'] is None else 'MISSED'}")
@@ -293,7 +303,7 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
     fr = {c: res[f"fractal_{c}"] for c in FRACTALS}
     rep = {"quick": quick, "wall_s": wall, "created": time.strftime("%Y-%m-%d %H:%M:%S"),
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "python": platform.python_version(),
-                       "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
+                       "numpy": np.__version__, "ffmpeg": ffmpeg_version(), "load_avg": LOAD_AT_START},
            "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
            "sim_speedup_vs_numpy_1e5": at[headline], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
            "fractal_fps": {c: r["fps"] for c, r in fr.items()},  # DESIGN.md: per colouring
@@ -311,6 +321,13 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
         rep["targets"][key] = {"value": val, "goal": f"{op} {goal:g}", "met": met,
                                "value_over_goal": None if val is None else val / goal}
     return rep
+
+
+def targets_table(r: dict) -> list[str]:
+    """The targets as a table: report.md's, and targets.md's, which the README's Performance section shows."""
+    return table(["target", "measured", "goal", "met", "measured / goal"],
+                 [[k, fmt(g["value"]), g["goal"], "yes" if g["met"] else "not measured" if g["met"] is None
+                   else "**no**", fmt(g["value_over_goal"], ".2f")] for k, g in r["targets"].items()])
 
 
 def fmt(val, spec=".3g") -> str:
@@ -335,9 +352,7 @@ def markdown(r: dict) -> str:
     out = [f"# pendulum bench{' --quick' if r['quick'] else ''}", "",
            f"{r['created']}, {m['cpus']} CPUs ({m['cpu']}), Python {m['python']}, numpy {m['numpy']}, ffmpeg "
            f"{m['ffmpeg']}. Every figure comes from this one run ({r['wall_s']:.0f} s).", "", "## Targets", ""]
-    out += table(["target", "measured", "goal", "met", "measured / goal"],
-                 [[k, fmt(g["value"]), g["goal"], "yes" if g["met"] else "not measured" if g["met"] is None
-                   else "**no**", fmt(g["value_over_goal"], ".2f")] for k, g in r["targets"].items()])
+    out += targets_table(r)
     if missed:
         out += ["", f"Missed: {', '.join(missed)}. What limits it is profiled in benchmarks/README.md."]
     if r["quick"]:

@@ -16,21 +16,22 @@ except ImportError:  # the bench says so once and writes null
     numba = None
 
 MISSING = "numba is not installed (pip install -e '.[bench]'): the numba peer is skipped, its keys are null"
-SYSTEMS = ("rigid", "elastic")
 
 
 def numba_rk4(scene, dtype):
-    """advance(q, v, steps, h) in place on (N, D) arrays of `dtype`, for the scene's system; None without numba
-    or for a system the peer does not cover. Constants are of `dtype`, so f32 stays f32 arithmetic."""
-    if numba is None or scene.system not in SYSTEMS:
+    """advance(q, v, steps, h) in place on (N, D) arrays of `dtype`, for the scene's model (render/reference.py:
+    a chain of two rods, or two springs); None without numba or for another model. Constants are of `dtype`,
+    so f32 stays f32 arithmetic."""
+    p = scene.pendulums
+    chain = scene.model == "chain" and len(p.lengths) == 2
+    if numba is None or not (chain or scene.model == "springs"):
         return None
     from numba import njit, prange
     f = dtype.type
-    p = scene.pendulums
     (m1, m2), (l1, l2), g = (f(m) for m in p.masses), (f(x) for x in p.lengths), f(p.gravity)
     half, two, six = f(0.5), f(2.0), f(6.0)
 
-    if scene.system == "rigid":
+    if chain:
         @njit(fastmath=True, inline="always")
         def accel(q1, q2, w1, w2):
             s1, c1, s2, c2 = math.sin(q1), math.cos(q1), math.sin(q2), math.cos(q2)
@@ -108,17 +109,19 @@ def numba_rk4(scene, dtype):
 
 def throughput_keys(rows: list[dict], render_s: float, video_s: float) -> dict:
     """Issue 17's report keys from the sim phase's rows at N = 1e5 and the timed rigid_chaos render; a ratio
-    against a peer that did not run (numba missing) is null."""
+    against a peer that did not run (numba missing) is null. The rows come in bench.SIM_PRESETS' order: the
+    rigid pendulum's system first, then the elastic one's."""
+    rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
     at = {(r["system"], r["precision"]): r for r in rows if r["n"] == 10**5}
 
     def ratio(system, peer):
         r = at.get((system, "f64"))
         return r["taichi"] / r[peer] if r and r.get(peer) else None
-    return {"sim_speedup_vs_numba_1e5": ratio("rigid", "numba"),
-            "rigid_f64_steps_per_s_1e5": at[("rigid", "f64")]["taichi"],
-            "rigid_f32_steps_per_s_1e5": at[("rigid", "f32")]["taichi"],
-            "elastic_speedup_vs_numpy_1e5": ratio("elastic", "numpy"),
-            "elastic_speedup_vs_numba_1e5": ratio("elastic", "numba"),
+    return {"sim_speedup_vs_numba_1e5": ratio(rigid, "numba"),
+            "rigid_f64_steps_per_s_1e5": at[(rigid, "f64")]["taichi"],
+            "rigid_f32_steps_per_s_1e5": at[(rigid, "f32")]["taichi"],
+            "elastic_speedup_vs_numpy_1e5": ratio(elastic, "numpy"),
+            "elastic_speedup_vs_numba_1e5": ratio(elastic, "numba"),
             "render_over_realtime": render_s / video_s,
             "matplotlib_peer_ratio": None}  # no matplotlib FuncAnimation peer in the code base yet
 
