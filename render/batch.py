@@ -92,31 +92,32 @@ def check_key(key: str, what: str):
         raise SceneError(f"{what} {key}: is a section; give a key inside it")
 
 
-def parse_sweeps(items: list[str]) -> list[tuple[str, list[tuple[str, str]]]]:
-    """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]."""
+def parse_sweeps(items: list[str], what: str = "--sweep") -> list[tuple[str, list[tuple[str, str]]]]:
+    """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]; `what` names the option in errors (`compare`
+    parses its --vary lists here too)."""
     sweeps = []
     for item in items:
         key, sep, values = item.partition("=")
         key = key.strip()
         if not sep or not values.strip():
-            raise SceneError(f"--sweep {item!r}: expected KEY=V1,V2,...")
+            raise SceneError(f"{what} {item!r}: expected KEY=V1,V2,...")
         if key == "name":
-            raise SceneError("--sweep name: variants are named after the swept values")
-        check_key(key, "--sweep")
+            raise SceneError(f"{what} name: variants are named after the swept values")
+        check_key(key, what)
         vals = []
-        for raw in _split_top(values):
-            _, value = parse_override(f"{key}={raw}", "--sweep")
+        for raw in _split_top(values, what):
+            _, value = parse_override(f"{key}={raw}", what)
             vals.append((raw, _sanitize(_text(value))))
         if len({t for _, t in vals}) != len(vals):
-            raise SceneError(f"--sweep {key}: lists a value twice")
+            raise SceneError(f"{what} {key}: lists a value twice")
         sweeps.append((key, vals))
     return sweeps
 
 
-def _split_top(text: str) -> list[str]:
+def _split_top(text: str, what: str = "--sweep") -> list[str]:
     parts = [v.strip() for v in re.split(r",(?![^\[]*\])", text)]  # commas inside [...] do not split
     if not all(parts):
-        raise SceneError(f"--sweep: empty value in {text!r}")
+        raise SceneError(f"{what}: empty value in {text!r}")
     return parts
 
 

@@ -14,12 +14,12 @@ import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, show
+from . import accuracy, batch, bench, compare, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
 from .options import add_common, add_quality, check_writable, progress_wanted, thread_count
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, show)
+MODULES = (accuracy, batch, bench, compare, show)
 
 
 class Terminated(BaseException):
@@ -76,14 +76,15 @@ def cmd_render(args) -> int:
     scenes = distinct(scenes, args.out)
     check_writable(args.out)
     for scene in scenes:
-        if (args.out / scene.name).exists() and not (args.out / scene.name).is_dir():
-            raise SceneError(f"--out {args.out}: {args.out / scene.name} is a file; {scene.name} renders into a "
+        if scene.out_dir(args.out).exists() and not scene.out_dir(args.out).is_dir():
+            raise SceneError(f"--out {args.out}: {scene.out_dir(args.out)} is a file; {scene.name} renders into a "
                              f"folder of that name")
         budget.check(scene, registry.get(scene.system), args.out)
     for scene in scenes:
         meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),
                                threads=args.threads)
-        print(summary(meta, args.out / scene.name))
+        print(compare.summary(meta, scene.out_dir(args.out)) if scene.compare else
+              summary(meta, scene.out_dir(args.out)))
     return 0
 
 
