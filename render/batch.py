@@ -24,7 +24,8 @@ from pathlib import Path
 from . import __version__, budget, gallery, registry
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
-from .options import add_common, add_quality, check_writable, positive_int, progress_wanted, thread_count
+from .options import (add_common, add_quality, check_writable, output_name, positive_int, progress_wanted,
+                      thread_count)
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -140,9 +141,13 @@ def variant_name(base: str, assignment: tuple[tuple[str, str], ...]) -> str:
 
 
 def plan(refs, overrides, sweeps, quality=None) -> list[dict]:
-    """One job per output: {'name', 'scene'} or, when the preset is bad, {'name', 'error'}."""
+    """One job per output: {'name', 'scene'} or, when the preset is bad, {'name', 'error'}.
+
+    As with `render`, OUT/NAME/ is only ever the preset as written: with --set or --quality a render is
+    NAME__<short hash> (options.output_name), a sweep's NAME__KEY_VALUE__<short hash>."""
     for item in overrides:
         check_key(".".join(parse_override(item)[0]), "--set")
+    overridden = bool(overrides or quality)
     jobs = []
     for ref in refs:
         try:
@@ -151,13 +156,15 @@ def plan(refs, overrides, sweeps, quality=None) -> list[dict]:
             jobs.append({"name": Path(ref).stem, "error": str(e)})
             continue
         if not sweeps:
+            base = output_name(base, overridden)
             jobs.append({"name": base.name, "scene": base})
             continue
         for combo in itertools.product(*[[(k, raw, t) for raw, t in vals] for k, vals in sweeps]):
             name = variant_name(base.name, tuple((k, t) for k, _, t in combo))
             sets = [*overrides, *(f"{k}={raw}" for k, raw, _ in combo), f"name={json.dumps(name)}"]
             try:
-                jobs.append({"name": name, "scene": load(ref, sets, quality)})
+                scene = output_name(load(ref, sets, quality), overridden)
+                jobs.append({"name": scene.name, "scene": scene})
             except SceneError as e:
                 jobs.append({"name": name, "error": str(e)})
     seen = {}
@@ -317,9 +324,10 @@ def run(args) -> int:
             print(f"pendulum: failed: {e}", file=sys.stderr)
             return 1
     if address:
+        folders = {j["name"]: j["scene"].out_dir(out_root) for j in jobs_plan if "scene" in j}
         for name, row in rows.items():
-            if row["status"] == "ok" and not (out_root / name / "metadata.json").is_file():
-                print(f"warning: {name} was rendered but {out_root / name} is not visible here; --out must be "
+            if row["status"] == "ok" and not (folders[name] / "metadata.json").is_file():
+                print(f"warning: {name} was rendered but {folders[name]} is not visible here; --out must be "
                       f"a directory shared by this machine and the workers", file=sys.stderr)
     ordered = [rows[j["name"]] for j in jobs_plan]
     wall = time.perf_counter() - t0
