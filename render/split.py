@@ -30,6 +30,7 @@ from . import integrators, registry, runtime
 GAP = 2  # px of grey at least between panels
 DIVIDER = 72  # its grey level
 LARGE = 300  # panels at least this tall get the 10x20 font, smaller ones 6x13
+LABEL_SHARE = 0.4  # of a panel's height its label may cover (from the top)
 COLOURS = {"title": (1.0, 1.0, 1.0), "detail": (0.7, 0.7, 0.7), "close": (0.45, 0.95, 0.5),
            "parted": (1.0, 0.55, 0.2), "finest": (0.55, 0.75, 1.0)}
 
@@ -37,6 +38,13 @@ COLOURS = {"title": (1.0, 1.0, 1.0), "detail": (0.7, 0.7, 0.7), "close": (0.45, 
 def cost(run: dict) -> float:
     """Wall seconds of simulation per simulated second, as measured in pass 1 (pipeline.record)."""
     return run["cost"]
+
+
+def shown(lines: list, room: int) -> list:
+    """The label's lines that fit in `room` lines, in their order: the integrator's line goes first, then
+    the cost; the variant and its error always stay."""
+    drop = [1, 2][:max(0, len(lines) - room)]
+    return [line for k, line in enumerate(lines) if k not in drop]
 
 
 def fit(text: str, width: int, cell: int) -> str:
@@ -176,7 +184,8 @@ class SplitScreen:
         """Every panel's label (and, with 3 variants, the legend in the free cell) as Font.draw_many items."""
         big = self.size == "10x20"
         pad, step, cell = (8, 21, 10) if big else (4, 13, 6)
-        cells = [(rect, self.label_lines(i, f)) for i, rect in enumerate(self.rects)]
+        room = max(2, int(LABEL_SHARE * self.rects[0][3]) // step)  # a small panel keeps its pendulums in view
+        cells = [(rect, shown(self.label_lines(i, f), room)) for i, rect in enumerate(self.rects)]
         if len(self.rects) == 3:
             cells.append((layout(self.scene.video.width, self.scene.video.height, 4)[3],
                           [(text, "detail") for text in self.legend()]))
