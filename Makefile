@@ -38,6 +38,7 @@ batch: $(BIN)/pendulum
 figures: $(BIN)/pendulum
 	$(BIN)/pendulum accuracy
 	$(BIN)/python benchmarks/seed_table.py
+	$(BIN)/python benchmarks/compare_still.py
 	$(BIN)/python benchmarks/readme_figures.py
 
 clean:

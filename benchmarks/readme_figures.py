@@ -22,6 +22,7 @@ FIGURES = ROOT / "benchmarks" / "figures"
 IMAGES = {  # out/<source> -> benchmarks/figures/<name>
     "accuracy/work_precision_rigid_chaos.png": "work_precision_rigid_chaos.png",
     "accuracy/faithful_rigid_chaos.png": "faithful_rigid_chaos.png",
+    "figures/compare_precision.png": "compare_precision.png",  # benchmarks/compare_still.py
 }
 BLOCK = re.compile(r"(<!-- generated: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.S)
 

@@ -173,7 +173,7 @@ class SplitScreen:
                  (f"{integ['method']}, dt {1e3 * integ['dt']:.3g} ms, {integ['precision']}", "detail"),
                  (f"cost {1e3 * self.costs[i]:.3g} ms per simulated s", "detail")]
         if i == self.ref:
-            return lines + [(f"finest: the others' {self.delta} is from it", "finest")]
+            return lines + [(f"finest: the reference for {self.delta}", "finest")]
         err = f"{self.delta} {amount(self.errors[i][f])}{' rad' if self.angles else ''}"
         parted = self.parted[i]
         if parted is not None and f / self.scene.video.fps >= parted:
