@@ -10,13 +10,14 @@ Validator.build returns plain, validated sections; scene.from_dict turns them in
 from __future__ import annotations
 
 import difflib
+import json
 import math
 import re
 
 from . import keys, registry
 from .errors import SceneError
 from .quality import LEVELS
-from .vary import PANEL_MIN, VARIANTS, VARYING, dotted, frozen, vary_refusal
+from .vary import PANEL_MIN, VARIANTS, VARYING, dotted, frozen, plain, vary_refusal
 
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
@@ -280,15 +281,16 @@ class Validator:
             lo, hi = VARIANTS
             if not isinstance(values, list) or not lo <= len(values) <= hi:
                 self.fail(name, f"must list {lo} to {hi} values (one per panel), got {clip(repr(values))}")
-            if any(isinstance(v, dict) for v in values):
-                self.fail(name, f"lists a table; each value is one value of {key}")
+            if not all(plain(v) for v in values):
+                self.fail(name, f"values are numbers, strings, booleans or lists of them (one value of {key} "
+                          f"each), got {clip(repr(values))}")
             if out and len(values) != len(out[0][1]):
                 self.fail(name, f"lists {len(values)} values and {out[0][0]} lists {len(out[0][1])}: varied keys "
                           f"are paired, one value per panel")
             out.append((key, frozen(values)))
         columns = list(zip(*(values for _, values in out)))
         if len(set(columns)) != len(columns):
-            self.fail("compare.vary", f"two panels would be the same variant: {[list(c) for c in columns]}")
+            self.fail("compare.vary", f"two panels would be the same variant: {clip(json.dumps(columns))}")
         if pend["layout"] == "grid":
             self.fail("compare", "a grid (one pendulum per pixel) cannot be split into panels")
         rows = 1 if len(columns) == 2 else 2

@@ -48,3 +48,8 @@ def vary_refusal(key: str) -> str | None:
 def frozen(value):
     """Lists to tuples, so a scene holding them stays hashable."""
     return tuple(frozen(v) for v in value) if isinstance(value, list) else value
+
+
+def plain(value) -> bool:
+    """A value a comparison can hold: what TOML and --vary give for a key's value (no tables, no dates)."""
+    return isinstance(value, (bool, int, float, str)) or (isinstance(value, list) and all(map(plain, value)))

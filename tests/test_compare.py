@@ -158,6 +158,7 @@ def test_bad_comparisons_exit_2_with_one_line_and_write_nothing(tmp_path, args, 
     ('varry = { "integrator.dt" = [1e-3, 2e-3] }', ["compare.varry", "did you mean 'compare.vary'"]),
     ('vary = { "pendulums.stiffness" = [1.0, 2.0] }', ["compare.vary.pendulums.stiffness", "unknown key"]),
     ('vary = { "integrator.dt" = [1e-3, 2e-3], "integrator.method" = ["rk4", "rk2", "rk4"] }', ["paired"]),
+    ('vary = { "integrator.dt" = [1979-05-27, 1e-3] }', ["compare.vary.integrator.dt", "numbers, strings"]),
 ])
 def test_a_bad_compare_table_is_bad_input_naming_file_and_key(tmp_path, table, needles):
     preset = preset_copy(tmp_path, "mine", extra=f"\n[compare]\n{table}\n")
