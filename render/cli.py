@@ -14,12 +14,12 @@ import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, show
+from . import accuracy, batch, bench, compare, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, add_quality, check_writable, progress_wanted, thread_count
+from .options import add_common, add_name, add_quality, check_writable, output_name, progress_wanted, thread_count
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, show)
+MODULES = (accuracy, batch, bench, compare, show)
 
 
 class Terminated(BaseException):
@@ -40,10 +40,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("render", help="render presets to out/NAME/ (MP4, GIF, metadata.json)",
                        description="Simulate each preset, draw every frame offscreen and encode MP4 and GIF "
-                                   "into OUT/NAME/ with a metadata.json.")
+                                   "into OUT/NAME/ with a metadata.json. OUT/NAME/ is only ever the preset as "
+                                   "written: with --set or --quality the render goes to OUT/NAME__<short hash of "
+                                   "the resolved scene>/ (or the folder --name gives), and says where. A preset "
+                                   "with a [compare] table renders its split-screen comparison into "
+                                   "OUT/compare/NAME/ (see `pendulum compare`).")
     r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(r)
     r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    add_name(r)
     add_quality(r)
     r.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -73,17 +78,21 @@ def cmd_render(args) -> int:
     from .scene import load
 
     scenes = [load(p, args.overrides, args.quality) for p in args.presets]  # all validated before any work
-    scenes = distinct(scenes, args.out)
+    if args.name and len(scenes) > 1:
+        raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
+    overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
+    scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
     check_writable(args.out)
     for scene in scenes:
-        if (args.out / scene.name).exists() and not (args.out / scene.name).is_dir():
-            raise SceneError(f"--out {args.out}: {args.out / scene.name} is a file; {scene.name} renders into a "
+        if scene.out_dir(args.out).exists() and not scene.out_dir(args.out).is_dir():
+            raise SceneError(f"--out {args.out}: {scene.out_dir(args.out)} is a file; {scene.name} renders into a "
                              f"folder of that name")
         budget.check(scene, registry.get(scene.system), args.out)
     for scene in scenes:
         meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),
                                threads=args.threads)
-        print(summary(meta, args.out / scene.name))
+        print(compare.summary(meta, scene.out_dir(args.out)) if scene.compare else
+              summary(meta, scene.out_dir(args.out)))
     return 0
 
 

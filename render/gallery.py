@@ -30,9 +30,11 @@ dl{display:grid;grid-template-columns:auto 1fr;gap:.1em .8em;margin:.6em 0 0}dt{
 
 
 def find_renders(out_root: Path) -> list[tuple[Path, dict]]:
-    """(directory, metadata) for each out_root/NAME/metadata.json that parses; sorted by name."""
+    """(directory, metadata) for each out_root/NAME/metadata.json (and comparison,
+    out_root/compare/NAME/metadata.json) that parses; sorted by name, comparisons last."""
     found = []
-    for meta_file in sorted(Path(out_root).glob("*/metadata.json")):
+    root = Path(out_root)
+    for meta_file in [*sorted(root.glob("*/metadata.json")), *sorted(root.glob("compare/*/metadata.json"))]:
         try:
             meta = json.loads(meta_file.read_text())
         except (OSError, ValueError):
@@ -56,7 +58,7 @@ def write_index(out_root: Path, failed: list[tuple[str, str]] = ()) -> Path:
         items = "".join(f"<li><b>{_e(name)}</b>: {_e(err)}</li>" for name, err in failed)
         parts.append(f'<div class="failed"><b>Failed in the last batch</b><ul>{items}</ul></div>')
     parts.append('<div class="grid">')
-    parts += [card(d, meta) for d, meta in renders]
+    parts += [card(d, meta, d.relative_to(out_root)) for d, meta in renders]
     parts.append("</div></body></html>\n")
     path = out_root / "index.html"
     write_atomic(path, "\n".join(parts))
@@ -66,7 +68,7 @@ def write_index(out_root: Path, failed: list[tuple[str, str]] = ()) -> Path:
 def up_to_date(scene, out_root: Path) -> dict | None:
     """The existing metadata when out_root/NAME holds this scene's render by this version, files intact:
     each output's size and sha256 as metadata.json records them (a render without hashes is redone)."""
-    d = Path(out_root) / scene.name
+    d = scene.out_dir(out_root)
     try:
         meta = json.loads((d / "metadata.json").read_text())
         if meta["preset_hash"] != scene.hash() or meta["versions"]["package"] != __version__:
@@ -90,14 +92,15 @@ def row_from_meta(name: str, status: str, meta: dict, wall_s: float | None) -> d
             "preset_hash": meta.get("preset_hash")}
 
 
-def card(out_dir: Path, meta: dict) -> str:
+def card(out_dir: Path, meta: dict, rel: Path | None = None) -> str:
+    """One render's card; links go to `rel`, its folder relative to the page (default: its name)."""
     preset = _get(meta, "preset", default={})
     name = str(preset.get("name") or out_dir.name) if isinstance(preset, dict) else out_dir.name
     outputs = _get(meta, "outputs", default={})
     files = [f for f in outputs if (out_dir / f).is_file()] if isinstance(outputs, dict) else []
     gif = next((f for f in files if f.endswith(".gif")), None)
     mp4 = next((f for f in files if f.endswith(".mp4")), None)
-    base = quote(out_dir.name)  # relative to index.html, which sits in out_root
+    base = quote((rel or Path(out_dir.name)).as_posix())  # relative to index.html, which sits in out_root
     img = (f'<a href="{base}/{_q(gif)}"><img src="{base}/{_q(gif)}" loading="lazy" alt="{_e(name)}"></a>'
            if gif else '<div class="nogif">no GIF rendered</div>')
     links = [f'<a href="{base}/{_q(f)}">{_e(f.rsplit(".", 1)[-1].upper())}</a> ({_size(outputs[f])})'

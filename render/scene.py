@@ -45,6 +45,7 @@ SCHEMA: dict[str, object] = {
     "effects": None,
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
     "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
+    "compare": None,  # a comparison: [compare] vary = { KEY = [V1, V2, ...] } (validate.py, split.py)
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64",
@@ -122,6 +123,7 @@ class Scene:
     quality: str | None = None
     fractal: str | None = None  # a map's colouring, None for a fan
     map: MapSpec | None = None
+    compare: tuple | None = None  # ((dotted key, (value per panel, ...)), ...): a split-screen comparison
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -140,11 +142,42 @@ class Scene:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
+        if self.fractal is None:  # a fan has no map (its [map] is the defaults): it hashes as before maps
+            d.pop("fractal")
+            d.pop("map")
+        if self.compare is None:
+            d.pop("compare")  # a scene without a comparison hashes as it did before there were any
+        else:
+            d["compare"] = {"vary": {key: values for key, values in self.compare}}
         return json.loads(json.dumps(d))  # tuples to lists: the same dict metadata.json reads back as
 
     def hash(self) -> str:
         blob = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def out_dir(self, root: Path) -> Path:
+        """Where the scene renders: ROOT/NAME/, a comparison ROOT/compare/NAME/."""
+        return Path(root) / ("compare" if self.compare else "") / self.name
+
+    def variants(self) -> list["Scene"]:
+        """A comparison's panels: this scene without its [compare] table, with value i of every varied key in
+        variant i; each validated as a preset is, its errors naming the variant."""
+        base = self.to_dict()
+        base.pop("compare", None)
+        out = []
+        for i in range(len(self.compare[0][1])):
+            d = json.loads(json.dumps(base))
+            for key, values in self.compare:
+                *sections, leaf = key.split(".")
+                node = d
+                for part in sections:
+                    node = node[part]
+                node[leaf] = json.loads(json.dumps(values[i]))
+                if key == "pendulums.damping":  # the validator adds the effect where damping > 0
+                    d["effects"] = [e for e in d["effects"] if e != "damping"]
+            label = ", ".join(f"{key}={json.dumps(values[i])}" for key, values in self.compare)
+            out.append(from_dict(d, f"{self.source} (compare variant {i + 1}: {label})"))
+        return out
 
     def replace(self, **sections) -> "Scene":
         """A copy with whole sections or fields swapped, e.g. replace(integrator={...})."""
@@ -249,9 +282,12 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     known = isinstance(system, str) and system in SYSTEMS  # else build() names the bad value
     schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
     d = v.build(v.merge(raw, schema, ""))
-    return Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
-                 Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
-                 source=src)
+    scene = Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
+                  Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
+                  d["compare"], source=src)
+    if scene.compare:
+        scene.variants()  # every variant's values are validated with the preset, before any work
+    return scene
 
 
 def _display(path: Path) -> str:
