@@ -13,12 +13,11 @@ import tomllib
 from pathlib import Path
 
 from . import keys, registry
+from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from .errors import SceneError
 from .quality import check_level
 from .validate import (EFFECTS, FORMATS, LAYOUTS, LINK_EFFECTS, MAX_PENDULUMS, MAX_PIXELS,  # noqa: F401
                        METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
-
-PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
@@ -145,24 +144,6 @@ class Scene:
 
 
 # ---------------------------------------------------------------- loading
-
-
-def preset_path(ref: str) -> Path:
-    """A preset name from presets/ or a path to a .toml file."""
-    p = Path(ref)
-    if p.suffix == ".toml" or "/" in ref:
-        if not p.is_file():
-            raise SceneError(f"{ref}: preset file not found")
-        return p
-    cand = PRESET_DIR / f"{ref}.toml"
-    if not cand.is_file():
-        names = [q.stem for q in PRESET_DIR.glob("*.toml")]
-        raise SceneError(f"{ref}: no such preset{hint(ref, names)} (see 'pendulum presets')")
-    return cand
-
-
-def list_presets() -> list[Path]:
-    return sorted(PRESET_DIR.glob("*.toml"))
 
 
 def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None) -> Scene:
