@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 from urllib.parse import quote
 
-from . import __version__
+from .version import __version__
 from .atomic import digest, write_atomic
 
 CSS = """

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, certify, quality, registry, runtime
+from . import certify, quality, registry, runtime
 from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
+from .version import __version__
 
 
 def make_system(scene, subset=None):

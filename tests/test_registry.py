@@ -30,8 +30,10 @@ def imported_modules(path: Path, known: set[str]) -> set[str]:
             if node.level:
                 anchor = package.split(".")[: len(package.split(".")) - (node.level - 1)]
                 base = ".".join(anchor + ([node.module] if node.module else []))
-            out.add(base)
-            out |= {f"{base}.{a.name}" for a in node.names}  # `from . import x` imports module x
+            names = {f"{base}.{a.name}" for a in node.names}  # `from . import x` imports module x
+            out |= names
+            if not names <= known:  # a name read from base itself (a function, __version__): base is needed;
+                out.add(base)       # `from . import x` of submodules only reads nothing the package defines
     return {m for m in out if m in known}
 
 
