@@ -1,4 +1,14 @@
-"""pendulum: double-pendulum presets to MP4 and GIF, simulated and drawn with Taichi."""
+"""pendulum: double-pendulum presets to MP4 and GIF, simulated and drawn with Taichi.
+
+The Python API (render/api.py, results in render/results.py):
+
+    import render
+    scene = render.load("classic", **{"video.duration": 2})   # the frozen, validated Scene
+    result = render.render(scene, out="out")                   # MP4, GIF, metadata.json, certificate
+    traj = render.simulate(scene)                              # t, theta/omega or pos/vel, energy
+
+Errors are the typed exceptions of render/errors.py: SceneError (bad input), SimulationError, EncodeError.
+"""
 import os
 
 from .version import __version__  # noqa: F401
@@ -7,3 +17,30 @@ from .version import __version__  # noqa: F401
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
 os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
 
+# Public names, imported on first use: `import render` stays cheap (Taichi, scipy and friends start only
+# when a function needs them), which keeps `pendulum --help` and `pendulum presets` as fast as they were.
+# compare(scene, vary={...}) joins them once render/compare.py has merged (see the note in render/api.py).
+__all__ = ["load", "render", "simulate", "RenderResult", "Trajectory", "Scene",
+           "SceneError", "SimulationError", "EncodeError"]
+
+
+def __getattr__(name):
+    if name in ("load", "render", "simulate"):
+        from . import api
+        value = getattr(api, name)
+    elif name in ("RenderResult", "Trajectory"):
+        from . import results
+        value = getattr(results, name)
+    elif name == "Scene":
+        from .scene import Scene as value
+    elif name in ("SceneError", "SimulationError", "EncodeError"):
+        from . import errors
+        value = getattr(errors, name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # looked up once
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *__all__])

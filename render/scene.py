@@ -146,7 +146,10 @@ class Scene:
 # ---------------------------------------------------------------- loading
 
 
-def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None) -> Scene:
+def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None,
+         values: dict | None = None) -> Scene:
+    """The preset `ref` with `--set` overrides ("a.b=TOML") and then `values` (dotted key -> Python value,
+    the API's keyword overrides) applied, validated."""
     path = preset_path(ref)
     src = _display(path)
     try:
@@ -162,7 +165,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         check_level(quality, src)
         raw["quality"] = quality
     for item in overrides:
-        _apply_override(raw, item, src)
+        _apply_override(raw, *parse_override(item, src), src)
+    for key, value in (values or {}).items():
+        _apply_override(raw, key.split("."), value, src, how="")
     return from_dict(raw, src)
 
 
@@ -185,12 +190,11 @@ def parse_override(item: str, src: str = "--set") -> tuple[list[str], object]:
     return key.split("."), value
 
 
-def _apply_override(raw: dict, item: str, src: str) -> None:
-    parts, value = parse_override(item, src)
+def _apply_override(raw: dict, parts: list[str], value, src: str, how: str = "--set ") -> None:
     node, schema = raw, SCHEMA
     for i, part in enumerate(parts[:-1]):
         if not isinstance(schema, dict) or not isinstance(schema.get(part), dict):
-            raise SceneError(f"{src}: --set {'.'.join(parts[:i + 1])}: not a section"
+            raise SceneError(f"{src}: {how}{'.'.join(parts[:i + 1])}: not a section"
                              f"{hint(part, _sections(schema))}")
         schema = schema[part]
         node = node.setdefault(part, {})
