@@ -13,12 +13,12 @@ import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, show
+from . import accuracy, batch, bench, gallery, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
 from .options import add_common, add_quality, progress_wanted, thread_count
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, show)
+MODULES = (accuracy, batch, bench, gallery, show)
 
 
 class Terminated(BaseException):
