@@ -20,7 +20,7 @@ from .options import check_writable
 from .results import RenderResult, Trajectory
 
 
-def load(preset: str | os.PathLike, *settings: str, quality: str | None = None, **overrides) -> scenes.Scene:
+def load(preset: str | os.PathLike, /, *settings: str, quality: str | None = None, **overrides) -> scenes.Scene:
     """The frozen, validated Scene of a preset (a name on the preset search path, or a .toml file).
 
     Overrides are dotted keys, `load("classic", **{"video.duration": 2})`, or nested dicts,

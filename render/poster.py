@@ -36,6 +36,6 @@ def ensure(video: Path, at_s: float) -> Path | None:
             subprocess.run(cmd, check=True, capture_output=True, timeout=TIMEOUT_S)
             if tmp.stat().st_size == 0:  # seeking past the end writes nothing, and says nothing
                 raise OSError("no frame")
-    except (OSError, subprocess.SubprocessError):
+    except (OSError, RuntimeError, subprocess.SubprocessError):  # RuntimeError: imageio-ffmpeg found no ffmpeg
         return None
     return path
