@@ -28,7 +28,8 @@ def chromium(page: Path, tmp: Path, *args: str) -> str:
     """Run headless Chromium on a file; its stdout. 10 s of virtual time: the page's media settle in far less,
     and virtual time only runs while the page is idle, so this is no wall-clock wait."""
     cmd = [BROWSER, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--mute-audio",
-           f"--user-data-dir={tmp / 'profile'}", "--virtual-time-budget=10000", *args, page.as_uri()]
+           f"--user-data-dir={tmp / 'profile'}", "--virtual-time-budget=10000", "--window-size=1280,2000", *args,
+           page.as_uri()]  # a tall window: every card in view, so lazy GIFs load too
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     return r.stdout
@@ -92,7 +93,7 @@ def test_a_broken_video_is_marked_on_its_card(gallery, tmp_path):
 def test_the_gallery_screenshot(gallery, tmp_path):
     SHOT.parent.mkdir(parents=True, exist_ok=True)
     SHOT.unlink(missing_ok=True)
-    chromium(gallery / "index.html", tmp_path, "--hide-scrollbars", "--window-size=1280,900",
+    chromium(gallery / "index.html", tmp_path, "--hide-scrollbars", "--window-size=1280,900",  # the last wins
              f"--screenshot={SHOT}")
     data = SHOT.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and struct.unpack(">II", data[16:24]) == (1280, 900)
