@@ -9,6 +9,8 @@ export TI_SKIP_VERSION_CHECK := ON
 $(BIN)/pendulum: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
+	@# the distribution was called "pendulum" before; a venv holding both would have two owners of render/
+	$(BIN)/python -m pip uninstall --quiet --yes pendulum 2>/dev/null || true
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $@
 

@@ -21,12 +21,13 @@ import threading
 import time
 from pathlib import Path
 
-from . import __version__, budget, gallery, registry
+from . import budget, gallery, registry
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
 from .options import (add_common, add_quality, check_writable, output_name, positive_int, progress_wanted,
                       thread_count)
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
+from .version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
 

@@ -39,9 +39,10 @@ GIF_BYTES_PER_PIXEL = 1.0
 GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 until palettegen has seen all
 
 
-def check(scene, system, out: Path, simulate: bool = False) -> None:
+def check(scene, system, out: Path | None, simulate: bool = False) -> None:
     """Refuse `scene` if its steps, memory or output exceed the limits. `system` is its System class (for
-    the size of its state); `out` is where the output goes (a folder, or the .npz's folder)."""
+    the size of its state); `out` is where the output goes (a folder, or the .npz's folder), None when
+    nothing is written (the API's simulate without a file)."""
     src = scene.source
     need, key, detail = memory(scene, system, simulate)
     limit, total = memory_limit()
@@ -49,8 +50,8 @@ def check(scene, system, out: Path, simulate: bool = False) -> None:
         raise SceneError(f"{src}: {key}: needs about {size(need)} of memory ({detail}), limit {size(limit)} "
                          f"({MEMORY_FRACTION:.0%} of this machine's {size(total)})")
     need, key, detail = output(scene, system, simulate)
-    where = existing(Path(out))
-    free = shutil.disk_usage(where).free
+    where = existing(Path(out)) if out is not None else None
+    free = shutil.disk_usage(where).free if where is not None else math.inf
     if need > free:
         raise SceneError(f"{src}: {key}: the output needs about {size(need)} of disk ({detail}), "
                          f"{size(free)} free in {where}")

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, certify, grid, quality, registry, runtime
+from . import certify, grid, quality, registry, runtime
 from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
+from .version import __version__
 
 
 def make_system(scene, subset=None):
@@ -182,8 +183,9 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     return meta
 
 
-def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -> dict:
-    """Write the state at every frame time to a .npz (DESIGN.md: t, theta/omega or pos/vel, energy)."""
+def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = False) -> dict:
+    """The state at every frame time (DESIGN.md: t, theta/omega or pos/vel, energy), as float64 arrays in
+    the returned info's "arrays", and written to out_file (a .npz) unless that is None."""
     if not scene.has("energy"):
         scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
     scene, chosen, cert, before = prepare(scene, arch, None)
@@ -198,12 +200,14 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
             for k, v in sim.state().items():
                 rows.setdefault(k, []).append(v)
             bar.update()
-    out_file = Path(out_file)
-    with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
-        np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in rows.items()}
+    if out_file is not None:
+        out_file = Path(out_file)
+        with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
+            np.savez_compressed(tmp, **arrays)
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
             "integrator": integrator_meta(scene, sim), "faithfulness": cert.to_dict(), "quality": chosen,
-            "line": cert.line()}
+            "line": cert.line(), "arrays": arrays}
 
 
 def integrator_meta(scene, sim) -> dict:

@@ -13,12 +13,11 @@ import tomllib
 from pathlib import Path
 
 from . import keys, registry
+from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from .errors import SceneError
 from .quality import check_level
 from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
                        MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
-
-PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
@@ -195,25 +194,10 @@ class Scene:
 # ---------------------------------------------------------------- loading
 
 
-def preset_path(ref: str) -> Path:
-    """A preset name from presets/ or a path to a .toml file."""
-    p = Path(ref)
-    if p.suffix == ".toml" or "/" in ref:
-        if not p.is_file():
-            raise SceneError(f"{ref}: preset file not found")
-        return p
-    cand = PRESET_DIR / f"{ref}.toml"
-    if not cand.is_file():
-        names = [q.stem for q in PRESET_DIR.glob("*.toml")]
-        raise SceneError(f"{ref}: no such preset{hint(ref, names)} (see 'pendulum presets')")
-    return cand
-
-
-def list_presets() -> list[Path]:
-    return sorted(PRESET_DIR.glob("*.toml"))
-
-
-def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None) -> Scene:
+def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None,
+         values: dict | None = None) -> Scene:
+    """The preset `ref` with `--set` overrides ("a.b=TOML") and then `values` (dotted key -> Python value,
+    the API's keyword overrides) applied, validated."""
     path = preset_path(ref)
     src = _display(path)
     try:
@@ -229,7 +213,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         check_level(quality, src)
         raw["quality"] = quality
     for item in overrides:
-        _apply_override(raw, item, src)
+        _apply_override(raw, *parse_override(item, src), src)
+    for key, value in (values or {}).items():
+        _apply_override(raw, key.split("."), value, src, how="")
     return from_dict(raw, src)
 
 
@@ -252,12 +238,11 @@ def parse_override(item: str, src: str = "--set") -> tuple[list[str], object]:
     return key.split("."), value
 
 
-def _apply_override(raw: dict, item: str, src: str) -> None:
-    parts, value = parse_override(item, src)
+def _apply_override(raw: dict, parts: list[str], value, src: str, how: str = "--set ") -> None:
     node, schema = raw, SCHEMA
     for i, part in enumerate(parts[:-1]):
         if not isinstance(schema, dict) or not isinstance(schema.get(part), dict):
-            raise SceneError(f"{src}: --set {'.'.join(parts[:i + 1])}: not a section"
+            raise SceneError(f"{src}: {how}{'.'.join(parts[:i + 1])}: not a section"
                              f"{hint(part, _sections(schema))}")
         schema = schema[part]
         node = node.setdefault(part, {})

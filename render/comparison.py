@@ -82,6 +82,11 @@ def with_vary(scene, items: list[str]):
             raise SceneError(f"--vary {key}: {len(vals)} values and {first} has {len(vary[first])}: --vary lists "
                              f"are paired, one value per panel")
         vary[key] = [parse_override(f"{key}={raw}", "--vary")[1] for raw, _ in vals]
+    return with_table(scene, vary)
+
+
+def with_table(scene, vary: dict):
+    """The scene with [compare] vary = `vary` (dotted key -> one value per panel), validated as a preset's."""
     raw = scene.to_dict()
     raw["compare"] = {"vary": vary}
     return from_dict(raw, scene.source)
