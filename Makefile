@@ -9,6 +9,8 @@ export TI_SKIP_VERSION_CHECK := ON
 $(BIN)/pendulum: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
+	@# the distribution was called "pendulum" before; a venv holding both would have two owners of render/
+	$(BIN)/python -m pip uninstall --quiet --yes pendulum 2>/dev/null || true
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $@
 
@@ -42,6 +44,7 @@ figures: $(BIN)/pendulum
 	$(BIN)/python benchmarks/effects.py --clock cpu --out out/bench/effects.md
 	$(BIN)/python benchmarks/frame.py rigid_chaos --at 10 --out out/figures/hud_rigid_chaos.png
 	$(BIN)/python benchmarks/frame.py rainbow_1000 --at 5 --out out/figures/glow_rainbow_1000.png
+	$(BIN)/python benchmarks/compare_still.py
 	$(BIN)/python benchmarks/readme_figures.py
 
 clean:

@@ -21,11 +21,13 @@ import threading
 import time
 from pathlib import Path
 
-from . import __version__, budget, gallery, registry
+from . import budget, gallery, registry
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
-from .options import add_common, add_quality, check_writable, positive_int, progress_wanted, thread_count
+from .options import (add_common, add_quality, check_writable, output_name, positive_int, progress_wanted,
+                      thread_count)
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
+from .version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
 
@@ -92,31 +94,32 @@ def check_key(key: str, what: str):
         raise SceneError(f"{what} {key}: is a section; give a key inside it")
 
 
-def parse_sweeps(items: list[str]) -> list[tuple[str, list[tuple[str, str]]]]:
-    """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]."""
+def parse_sweeps(items: list[str], what: str = "--sweep") -> list[tuple[str, list[tuple[str, str]]]]:
+    """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]; `what` names the option in errors (`compare`
+    parses its --vary lists here too)."""
     sweeps = []
     for item in items:
         key, sep, values = item.partition("=")
         key = key.strip()
         if not sep or not values.strip():
-            raise SceneError(f"--sweep {item!r}: expected KEY=V1,V2,...")
+            raise SceneError(f"{what} {item!r}: expected KEY=V1,V2,...")
         if key == "name":
-            raise SceneError("--sweep name: variants are named after the swept values")
-        check_key(key, "--sweep")
+            raise SceneError(f"{what} name: variants are named after the swept values")
+        check_key(key, what)
         vals = []
-        for raw in _split_top(values):
-            _, value = parse_override(f"{key}={raw}", "--sweep")
+        for raw in _split_top(values, what):
+            _, value = parse_override(f"{key}={raw}", what)
             vals.append((raw, _sanitize(_text(value))))
         if len({t for _, t in vals}) != len(vals):
-            raise SceneError(f"--sweep {key}: lists a value twice")
+            raise SceneError(f"{what} {key}: lists a value twice")
         sweeps.append((key, vals))
     return sweeps
 
 
-def _split_top(text: str) -> list[str]:
+def _split_top(text: str, what: str = "--sweep") -> list[str]:
     parts = [v.strip() for v in re.split(r",(?![^\[]*\])", text)]  # commas inside [...] do not split
     if not all(parts):
-        raise SceneError(f"--sweep: empty value in {text!r}")
+        raise SceneError(f"{what}: empty value in {text!r}")
     return parts
 
 
@@ -139,9 +142,13 @@ def variant_name(base: str, assignment: tuple[tuple[str, str], ...]) -> str:
 
 
 def plan(refs, overrides, sweeps, quality=None) -> list[dict]:
-    """One job per output: {'name', 'scene'} or, when the preset is bad, {'name', 'error'}."""
+    """One job per output: {'name', 'scene'} or, when the preset is bad, {'name', 'error'}.
+
+    As with `render`, OUT/NAME/ is only ever the preset as written: with --set or --quality a render is
+    NAME__<short hash> (options.output_name), a sweep's NAME__KEY_VALUE__<short hash>."""
     for item in overrides:
         check_key(".".join(parse_override(item)[0]), "--set")
+    overridden = bool(overrides or quality)
     jobs = []
     for ref in refs:
         try:
@@ -150,13 +157,15 @@ def plan(refs, overrides, sweeps, quality=None) -> list[dict]:
             jobs.append({"name": Path(ref).stem, "error": str(e)})
             continue
         if not sweeps:
+            base = output_name(base, overridden)
             jobs.append({"name": base.name, "scene": base})
             continue
         for combo in itertools.product(*[[(k, raw, t) for raw, t in vals] for k, vals in sweeps]):
             name = variant_name(base.name, tuple((k, t) for k, _, t in combo))
             sets = [*overrides, *(f"{k}={raw}" for k, raw, _ in combo), f"name={json.dumps(name)}"]
             try:
-                jobs.append({"name": name, "scene": load(ref, sets, quality)})
+                scene = output_name(load(ref, sets, quality), overridden)
+                jobs.append({"name": scene.name, "scene": scene})
             except SceneError as e:
                 jobs.append({"name": name, "error": str(e)})
     seen = {}
@@ -316,9 +325,10 @@ def run(args) -> int:
             print(f"pendulum: failed: {e}", file=sys.stderr)
             return 1
     if address:
+        folders = {j["name"]: j["scene"].out_dir(out_root) for j in jobs_plan if "scene" in j}
         for name, row in rows.items():
-            if row["status"] == "ok" and not (out_root / name / "metadata.json").is_file():
-                print(f"warning: {name} was rendered but {out_root / name} is not visible here; --out must be "
+            if row["status"] == "ok" and not (folders[name] / "metadata.json").is_file():
+                print(f"warning: {name} was rendered but {folders[name]} is not visible here; --out must be "
                       f"a directory shared by this machine and the workers", file=sys.stderr)
     ordered = [rows[j["name"]] for j in jobs_plan]
     wall = time.perf_counter() - t0

@@ -39,9 +39,10 @@ GIF_BYTES_PER_PIXEL = 1.0
 GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 until palettegen has seen all
 
 
-def check(scene, system, out: Path, simulate: bool = False) -> None:
+def check(scene, system, out: Path | None, simulate: bool = False) -> None:
     """Refuse `scene` if its steps, memory or output exceed the limits. `system` is its System class (for
-    the size of its state); `out` is where the output goes (a folder, or the .npz's folder)."""
+    the size of its state); `out` is where the output goes (a folder, or the .npz's folder), None when
+    nothing is written (the API's simulate without a file)."""
     src = scene.source
     need, key, detail = memory(scene, system, simulate)
     limit, total = memory_limit()
@@ -49,8 +50,8 @@ def check(scene, system, out: Path, simulate: bool = False) -> None:
         raise SceneError(f"{src}: {key}: needs about {size(need)} of memory ({detail}), limit {size(limit)} "
                          f"({MEMORY_FRACTION:.0%} of this machine's {size(total)})")
     need, key, detail = output(scene, system, simulate)
-    where = existing(Path(out))
-    free = shutil.disk_usage(where).free
+    where = existing(Path(out)) if out is not None else None
+    free = shutil.disk_usage(where).free if where is not None else math.inf
     if need > free:
         raise SceneError(f"{src}: {key}: the output needs about {size(need)} of disk ({detail}), "
                          f"{size(free)} free in {where}")
@@ -63,6 +64,8 @@ def check(scene, system, out: Path, simulate: bool = False) -> None:
     ratio = 1.0 / per_frame if per_frame > 0 else math.inf
     substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
     check_steps(scene, substeps, 1.0 / (scene.video.fps * substeps))
+    for variant in scene.variants() if scene.compare else ():  # each panel at its own step
+        check(variant, system, out, simulate)
 
 
 def check_steps(scene, substeps: int, h: float) -> None:
@@ -102,11 +105,14 @@ def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
     canvas = pixels * 12 * (1 + scene.has("trails")) + n * 8 * (len(system.LINKS) + 1)
     queued = (QUEUE_FRAMES * len(v.formats) + 2) * pixels * 3
     gif = gif_frames(scene) * gif_pixels(scene) * GIF_BUFFER_BYTES_PER_PIXEL if "gif" in v.formats else 0
+    # A comparison keeps every variant's state at every frame until its panels are drawn (render/split.py).
+    kept = len(scene.compare[0][1]) * scene.frames * n * d * 8 if scene.compare else 0
     terms = {"pendulums.count": state, "video.width, video.height": canvas + queued,
-             "video.gif_width, video.duration": gif}
+             "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept}
     return sum(terms.values()), max(terms, key=terms.get), (
         f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
-        f"GIF frames held by ffmpeg {size(gif)}")
+        f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
+                                                   if kept else ""))
 
 
 def output(scene, system, simulate: bool) -> tuple[int, str, str]:

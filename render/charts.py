@@ -11,7 +11,7 @@ import numpy as np
 from .atomic import write_atomic
 
 COLORS = {"symplectic_euler": "tab:red", "verlet": "tab:orange", "implicit_midpoint": "tab:purple",
-          "rk4": "tab:blue", "yoshida4": "tab:green"}
+          "rk2": "tab:cyan", "rk4": "tab:blue", "yoshida4": "tab:green"}
 STYLE = {"f64": "-", "f32": "--"}
 COST = "cost: wall time per pendulum per simulated second [µs]  (= ns per step / dt)"
 

@@ -7,19 +7,18 @@ PENDULUM_DEBUG=1 prints the traceback as well.
 from __future__ import annotations
 
 import argparse
-import functools
 import os
 import signal
 import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, show
+from . import accuracy, batch, bench, comparison, gallery, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, add_quality, check_writable, progress_wanted, thread_count
+from .options import add_common, add_name, add_quality, output_name, progress_wanted, thread_count
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, show)
+MODULES = (accuracy, batch, bench, comparison, gallery, show)
 
 
 class Terminated(BaseException):
@@ -40,10 +39,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("render", help="render presets to out/NAME/ (MP4, GIF, metadata.json)",
                        description="Simulate each preset, draw every frame offscreen and encode MP4 and GIF "
-                                   "into OUT/NAME/ with a metadata.json.")
+                                   "into OUT/NAME/ with a metadata.json. OUT/NAME/ is only ever the preset as "
+                                   "written: with --set or --quality the render goes to OUT/NAME__<short hash of "
+                                   "the resolved scene>/ (or the folder --name gives), and says where. A preset "
+                                   "with a [compare] table renders its split-screen comparison into "
+                                   "OUT/compare/NAME/ (see `pendulum compare`).")
     r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(r)
     r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    add_name(r)
     add_quality(r)
     r.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -69,21 +73,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_render(args) -> int:
-    from . import budget, pipeline, registry
-    from .scene import load
+    from . import api
 
-    scenes = [load(p, args.overrides, args.quality) for p in args.presets]  # all validated before any work
-    scenes = distinct(scenes, args.out)
-    check_writable(args.out)
+    scenes = [api.load(p, *args.overrides, quality=args.quality) for p in args.presets]  # all validated first
+    if args.name and len(scenes) > 1:
+        raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
+    overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
+    scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
+    api.check_render(scenes, args.out)  # every scene's refusals before the first render
     for scene in scenes:
-        if (args.out / scene.name).exists() and not (args.out / scene.name).is_dir():
-            raise SceneError(f"--out {args.out}: {args.out / scene.name} is a file; {scene.name} renders into a "
-                             f"folder of that name")
-        budget.check(scene, registry.get(scene.system), args.out)
-    for scene in scenes:
-        meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args),
-                               threads=args.threads)
-        print(summary(meta, args.out / scene.name))
+        result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
+        print(result.line())
     return 0
 
 
@@ -98,43 +98,12 @@ def distinct(scenes: list, out: Path) -> list:
     return list(seen.values())
 
 
-def summary(meta: dict, out_dir: Path) -> str:
-    i, t = meta["integrator"], meta["timings_s"]
-    drift = meta["energy"]["max_rel_drift"] if meta["energy"] else None
-    drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
-    f, q = meta["faithfulness"], meta["quality"]
-    level = f" ({q['level']}: {'met' if q.get('met') else 'NOT met'})" if q["level"] else " (as the preset states)"
-    until = functools.partial(_until, duration=meta["duration"])
-    return (f"{meta['preset']['name']}: {meta['frames']} frames {meta['width']}x{meta['height']}@{meta['fps']} | "
-            f"{i['method']} dt={i['dt']:.3g}s x{i['substeps']} {i['precision']}{level}{drift_s} | "
-            f"faithful until {until(f['faithful_until_s'])} (median {until(f['median_until_s'])}, "
-            f"{100 * f['fraction_faithful']:.0f} % through {meta['duration']:g} s) at {f['tolerance']:g} {f['unit']} | "
-            f"simulate {t['simulate']:.2f}s draw {t['draw']:.2f}s encode {t['encode']:.2f}s "
-            f"total {t['total']:.2f}s -> {out_dir}/")
-
-
-def _until(t: float, duration: float) -> str:
-    return "the end" if t >= duration else f"{t:.2f} s"
-
-
 def cmd_simulate(args) -> int:
-    from . import budget, pipeline, registry
-    from .scene import load
+    from . import api
 
-    scene = load(args.preset, args.overrides, args.quality)
-    if args.out.suffix != ".npz":
-        raise SceneError(f"--out {args.out}: must end in .npz")
-    if args.out.is_dir():
-        raise SceneError(f"--out {args.out}: is a directory; give the file to write, e.g. {args.out / scene.name}.npz")
-    check_writable(args.out.parent)
-    budget.check(scene, registry.get(scene.system), args.out.parent, simulate=True)
-    try:
-        info = pipeline.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
-    except OSError as e:  # e.g. a full disk while writing: numpy's error does not say which file
-        if e.filename is None and e.strerror:
-            raise OSError(e.errno, e.strerror, str(args.out)) from e
-        raise
-    print(f"{scene.name}: {info['frames']} frames, {info['line']} -> {args.out}")
+    scene = api.load(args.preset, *args.overrides, quality=args.quality)
+    traj = api.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
+    print(f"{scene.name}: {traj.info['frames']} frames, {traj.info['line']} -> {args.out}")
     return 0
 
 

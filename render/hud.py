@@ -8,6 +8,9 @@
                   with ticks where the render stops being faithful (the same times as the top right)
     bottom right  a one-line caption: the preset's description, cut to fit
 
+In a split-screen panel (render/split.py) the panel's label says the method, step, cost and error at the top,
+so the HUD keeps the spread and the timeline and puts the clock where the caption was.
+
 The left and right columns lie outside the circle the pendulums can reach (the canvas frames it at 0.92 of
 the height), so the HUD covers no pendulum on a 16:9 frame. Sizes follow the frame's height (faces()); at
 small sizes (under 360 px) the certificate's words and the axis labels are left out and its ticks and the
@@ -45,12 +48,14 @@ class Info:
     precision: str
     faithful_until_s: float | None = None  # the certificate (render/certify.py), if there is one
     median_until_s: float | None = None
+    panel: bool = False  # a split-screen panel (render/split.py): its label already says method, step and error
 
     @classmethod
-    def of(cls, scene, dt=None, cert=None):
+    def of(cls, scene, dt=None, cert=None, panel=False):
         i = scene.integrator
         return cls(scene.description, i.method, i.dt if dt is None else dt, i.precision,
-                   None if cert is None else cert.faithful_until_s, None if cert is None else cert.median_until_s)
+                   None if cert is None else cert.faithful_until_s, None if cert is None else cert.median_until_s,
+                   panel)
 
 
 def faces(h: int) -> tuple[tuple[str, int], tuple[str, int], tuple[str, int]]:
@@ -115,13 +120,14 @@ class Hud(runtime.Launcher):
         self.ticks = tuple(self.x_of(t) for t, _ in self.until) + (-1,) * (2 - len(self.until))
         self.tick_colours = tuple(c for _, c in self.until) + (WHITE,) * (2 - len(self.until))
         self.tick_times = tuple(float(t) for t, _ in self.until) + (math.inf,) * (2 - len(self.until))
-        rows = [self.text(f"{info.method} · {info.precision}", m, m + bh + m // 2),
-                self.text(f"dt = {step(info.dt)} s", m, m + bh + m // 2 + sh)]
-        rows += self.certificate() + self.axis_labels()
-        right = self.gx1 + (self.cell(self.lab, ls)[0] * 5 if self.fan and self.words else 0) + 2 * m
-        chars = (w - m - right) // self.cell(self.small, ss)[0]
-        rows.append(self.text(fit(" ".join(info.caption.split()), chars), w - m, h - m, DIM, ha="right",
-                              va="bottom"))
+        rows = self.axis_labels()
+        if not info.panel:  # a panel's label covers its top, and the caption is the video's, not the panel's
+            rows += [self.text(f"{info.method} · {info.precision}", m, m + bh + m // 2),
+                     self.text(f"dt = {step(info.dt)} s", m, m + bh + m // 2 + sh)] + self.certificate()
+            right = self.gx1 + (self.cell(self.lab, ls)[0] * 5 if self.fan and self.words else 0) + 2 * m
+            chars = (w - m - right) // self.cell(self.small, ss)[0]
+            rows.append(self.text(fit(" ".join(info.caption.split()), chars), w - m, h - m, DIM, ha="right",
+                                  va="bottom"))
         self.static = np.concatenate(rows) if rows else np.zeros((0, 10), np.int32)
         if self.fan:
             self.spread = runtime.field("hud.spread", runtime.real(), ())
@@ -177,7 +183,10 @@ class Hud(runtime.Launcher):
         """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
         frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
         spread = self.launch("hud_graph", out, frame, self.x_of(t))  # returned: no field read, no extra launch
-        rows = [self.static, self.text(f"t = {t:5.2f} s", self.m, self.m, self.clock_colour(t), self.big, self.bs)]
+        clock = f"t = {t:5.2f} s"
+        rows = [self.static, self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big,
+                                       self.bs, ha="right", va="bottom") if self.info.panel else
+                self.text(clock, self.m, self.m, self.clock_colour(t), self.big, self.bs)]
         if self.fan:
             label = f"{'spread' if self.words else 'Δ'} {metres(spread)}"
             rows.append(self.text(label, *self.value_at, CURVE))

@@ -3,12 +3,14 @@ output-directory probe."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import tempfile
 from pathlib import Path
 
 from .errors import SceneError
 from .quality import LEVELS
+from .validate import NAME_MAX, NAME_PATTERN
 
 # Taichi starts one OS thread per thread asked for: 4096 started in under a second here, 100000 hung.
 # Beyond 1024 a CPU render only oversubscribes the cores.
@@ -27,6 +29,37 @@ def add_quality(p):
                    help="a guarantee instead of the preset's integrator: the median pendulum stays faithful for "
                         "50 %% (draft), 75 %% (standard) or 100 %% (high) of the video, met by the cheapest setting "
                         "that pilot runs show meets it; reference: the finest step")
+
+
+def add_name(p):
+    p.add_argument("--name", type=folder_name, metavar="NAME2",
+                   help="the output folder's name (and the files'), instead of NAME, or NAME__<hash> with "
+                        "--set or --quality")
+
+
+def folder_name(text: str) -> str:
+    """An argparse type: a name a scene may have (validate.py), so it is safe as a folder and file name."""
+    if not re.fullmatch(NAME_PATTERN, text) or len(text) > NAME_MAX:
+        raise argparse.ArgumentTypeError(f"must be letters, digits, _ . - (not first . or -), at most {NAME_MAX} "
+                                         f"characters, got {text[:40]!r}")
+    return text
+
+
+HASH_CHARS = 8  # of the resolved scene's hash in an override folder's name
+
+
+def output_name(scene, overridden: bool, name: str | None = None):
+    """The scene under the name of the folder it renders to. OUT/NAME/ is only ever the preset as written:
+    with overrides (--set, --quality) the folder is NAME__<short hash of the resolved scene>, the same for
+    the same result however the overrides were spelled, unless --name gives it a name."""
+    if name is not None:
+        if overridden and name == scene.name:
+            raise SceneError(f"--name {name}: is the folder of the preset as written; name the render with "
+                             f"overrides otherwise")
+        return scene.replace(name=name)
+    if not overridden:
+        return scene
+    return scene.replace(name=f"{scene.name[:NAME_MAX - HASH_CHARS - 2]}__{scene.hash()[:HASH_CHARS]}")
 
 
 def positive_int(text: str, most: int | None = None) -> int:

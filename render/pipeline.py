@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, certify, grid, quality, registry, runtime
+from . import certify, grid, quality, registry, runtime
 from .atomic import digest, replacing, write_atomic
 from .system import DEFAULT_MAX_DRIFT
+from .version import __version__
 
 
 def make_system(scene, subset=None):
@@ -55,17 +56,17 @@ def frames(scene, sim, timings: dict, advance=None):
 
 @contextmanager
 def output_dir(path: Path):
-    """Create the directory; if it was new and the block fails, remove it again when empty."""
-    existed = path.exists()
+    """Create the directory; if the block fails, remove it again, and the parents it made, when empty."""
+    made = [p for p in (path, *path.parents) if not p.exists()]  # e.g. out/compare/ for a first comparison
     path.mkdir(parents=True, exist_ok=True)
     try:
         yield path
     except BaseException:
-        if not existed:
+        for p in made:  # deepest first
             try:
-                path.rmdir()
+                p.rmdir()
             except OSError:
-                pass
+                break
         raise
 
 
@@ -108,16 +109,51 @@ class Source:
         return frame
 
 
+def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
+    """A scene simulated to the end without drawing, as `render` simulates it (prepare(), the watchdog): a
+    comparison's variant, each in its own precision before the panels are drawn (render/split.py).
+
+    Returns the scene as run, `chosen`, `cert`, `timings`, `q` (frames, N, D) float64 at every frame time,
+    `cost` (wall seconds of simulation per simulated second, steady: from the second advance on, since the
+    first one compiles or loads the kernel), and what metadata reports of the run: `integrator`, `energy`,
+    `kernels`, `fields`."""
+    scene, chosen, cert, timings = prepare(scene, arch, threads)
+    runtime.init(arch, scene.integrator.precision, threads)
+    sim = make_system(scene)
+    timings["simulate"] = 0.0
+    q = np.empty((scene.frames, sim.n, sim.D))
+    warm = 0.0
+    for f in frames(scene, sim, timings):
+        q[f] = sim.q.to_numpy()
+        if f == 1:
+            warm = timings["simulate"]
+    steady = scene.frames - 2
+    cost = (timings["simulate"] - warm) * scene.video.fps / steady if steady > 0 else timings["simulate"] / \
+        scene.video.duration
+    return {"scene": scene, "chosen": chosen, "cert": cert, "timings": timings, "q": q, "cost": cost,
+            "integrator": integrator_meta(scene, sim), "energy": energy_meta(scene, sim),
+            "kernels": list(runtime.launched), "fields": dict(runtime.allocated)}
+
+
+def open_source(scene, arch: str = "cpu", threads: int | None = None):
+    """What `render` encodes and `show` plays: the scene's Source, or a comparison's split screen."""
+    if not scene.compare:
+        return Source(scene, arch, threads)
+    from .split import SplitScreen
+    return SplitScreen(scene, lambda variant: record(variant, arch, threads), arch, threads)
+
+
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
            frame_hook=None) -> dict:
-    """Render scene into out_root/NAME/; returns the metadata it wrote. frame_hook(f, frame) sees raw frames."""
+    """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
+    wrote. frame_hook(f, frame) sees raw frames."""
     from .encode import Encoder
 
     t_start = time.perf_counter()
-    src = Source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
+    src = open_source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
     scene, timings = src.scene, src.timings
     timings["encode"] = 0.0
-    with output_dir(Path(out_root) / scene.name) as out_dir:
+    with output_dir(scene.out_dir(out_root)) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video)
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
@@ -136,16 +172,20 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
-        meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen,
-                        {f: digest(out_dir / f) for f in sizes})
+        sha256 = {f: digest(out_dir / f) for f in sizes}
+        if scene.compare:
+            meta = src.metadata(header(scene, src.arch), timings, sizes, sha256)
+        else:
+            meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen, sha256)
         if scene.fractal:
             meta["map"] = src.canvas.summary()
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
 
-def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -> dict:
-    """Write the state at every frame time to a .npz (DESIGN.md: t, theta/omega or pos/vel, energy)."""
+def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = False) -> dict:
+    """The state at every frame time (DESIGN.md: t, theta/omega or pos/vel, energy), as float64 arrays in
+    the returned info's "arrays", and written to out_file (a .npz) unless that is None."""
     if not scene.has("energy"):
         scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
     scene, chosen, cert, before = prepare(scene, arch, None)
@@ -160,12 +200,14 @@ def simulate(scene, out_file: Path, arch: str = "cpu", progress: bool = False) -
             for k, v in sim.state().items():
                 rows.setdefault(k, []).append(v)
             bar.update()
-    out_file = Path(out_file)
-    with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
-        np.savez_compressed(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in rows.items()})
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in rows.items()}
+    if out_file is not None:
+        out_file = Path(out_file)
+        with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
+            np.savez_compressed(tmp, **arrays)
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
             "integrator": integrator_meta(scene, sim), "faithfulness": cert.to_dict(), "quality": chosen,
-            "line": cert.line()}
+            "line": cert.line(), "arrays": arrays}
 
 
 def integrator_meta(scene, sim) -> dict:
@@ -173,14 +215,11 @@ def integrator_meta(scene, sim) -> dict:
             "substeps": sim.substeps, "precision": scene.integrator.precision}
 
 
-def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict,
-             sha256: dict | None = None) -> dict:
+def header(scene, arch: str) -> dict:
+    """What every metadata.json opens with: the scene, the versions, the video."""
     import taichi as ti
     from .encode import ffmpeg_version
 
-    energy = None
-    if scene.has("energy"):
-        energy = {"initial_total": float(sim.e0.to_numpy().sum()), "max_rel_drift": float(sim.drift[None])}
     v = scene.video
     return {
         "preset": scene.to_dict(),
@@ -190,12 +229,25 @@ def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: di
                      "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
         "arch": arch,
         "frames": scene.frames, "fps": v.fps, "width": v.width, "height": v.height, "duration": v.duration,
+    }
+
+
+def energy_meta(scene, sim) -> dict | None:
+    if not scene.has("energy"):
+        return None
+    return {"initial_total": float(sim.e0.to_numpy().sum()), "max_rel_drift": float(sim.drift[None])}
+
+
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict,
+             sha256: dict | None = None) -> dict:
+    return {
+        **header(scene, arch),
         "integrator": integrator_meta(scene, sim),
         "effects": list(scene.effects),
         "kernels": list(runtime.launched),
         "field_bytes": sum(runtime.allocated.values()),
         "fields": dict(runtime.allocated),
-        "energy": energy,
+        "energy": energy_meta(scene, sim),
         "faithfulness": cert.to_dict(),
         "quality": chosen,
         "timings_s": {k: round(val, 4) for k, val in timings.items()},

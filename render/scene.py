@@ -13,12 +13,11 @@ import tomllib
 from pathlib import Path
 
 from . import keys, registry
+from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from .errors import SceneError
 from .quality import check_level
 from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
                        MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
-
-PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
@@ -45,6 +44,7 @@ SCHEMA: dict[str, object] = {
     "effects": None,
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
     "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
+    "compare": None,  # a comparison: [compare] vary = { KEY = [V1, V2, ...] } (validate.py, split.py)
     "pendulums": pendulum_keys(None),
     "integrator": {
         "method": "rk4", "dt": "auto", "precision": "f64", "trig": "inline",
@@ -123,6 +123,7 @@ class Scene:
     quality: str | None = None
     fractal: str | None = None  # a map's colouring, None for a fan
     map: MapSpec | None = None
+    compare: tuple | None = None  # ((dotted key, (value per panel, ...)), ...): a split-screen comparison
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -141,6 +142,13 @@ class Scene:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
+        if self.fractal is None:  # a fan has no map (its [map] is the defaults): it hashes as before maps
+            d.pop("fractal")
+            d.pop("map")
+        if self.compare is None:
+            d.pop("compare")  # a scene without a comparison hashes as it did before there were any
+        else:
+            d["compare"] = {"vary": {key: values for key, values in self.compare}}
         return json.loads(json.dumps(d))  # tuples to lists: the same dict metadata.json reads back as
 
     def hash(self) -> str:
@@ -149,6 +157,30 @@ class Scene:
             del d["integrator"]["trig"]
         blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def out_dir(self, root: Path) -> Path:
+        """Where the scene renders: ROOT/NAME/, a comparison ROOT/compare/NAME/."""
+        return Path(root) / ("compare" if self.compare else "") / self.name
+
+    def variants(self) -> list["Scene"]:
+        """A comparison's panels: this scene without its [compare] table, with value i of every varied key in
+        variant i; each validated as a preset is, its errors naming the variant."""
+        base = self.to_dict()
+        base.pop("compare", None)
+        out = []
+        for i in range(len(self.compare[0][1])):
+            d = json.loads(json.dumps(base))
+            for key, values in self.compare:
+                *sections, leaf = key.split(".")
+                node = d
+                for part in sections:
+                    node = node[part]
+                node[leaf] = json.loads(json.dumps(values[i]))
+                if key == "pendulums.damping":  # the validator adds the effect where damping > 0
+                    d["effects"] = [e for e in d["effects"] if e != "damping"]
+            label = ", ".join(f"{key}={json.dumps(values[i])}" for key, values in self.compare)
+            out.append(from_dict(d, f"{self.source} (compare variant {i + 1}: {label})"))
+        return out
 
     def replace(self, **sections) -> "Scene":
         """A copy with whole sections or fields swapped, e.g. replace(integrator={...})."""
@@ -166,25 +198,10 @@ class Scene:
 # ---------------------------------------------------------------- loading
 
 
-def preset_path(ref: str) -> Path:
-    """A preset name from presets/ or a path to a .toml file."""
-    p = Path(ref)
-    if p.suffix == ".toml" or "/" in ref:
-        if not p.is_file():
-            raise SceneError(f"{ref}: preset file not found")
-        return p
-    cand = PRESET_DIR / f"{ref}.toml"
-    if not cand.is_file():
-        names = [q.stem for q in PRESET_DIR.glob("*.toml")]
-        raise SceneError(f"{ref}: no such preset{hint(ref, names)} (see 'pendulum presets')")
-    return cand
-
-
-def list_presets() -> list[Path]:
-    return sorted(PRESET_DIR.glob("*.toml"))
-
-
-def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None) -> Scene:
+def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | None = None,
+         values: dict | None = None) -> Scene:
+    """The preset `ref` with `--set` overrides ("a.b=TOML") and then `values` (dotted key -> Python value,
+    the API's keyword overrides) applied, validated."""
     path = preset_path(ref)
     src = _display(path)
     try:
@@ -200,7 +217,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         check_level(quality, src)
         raw["quality"] = quality
     for item in overrides:
-        _apply_override(raw, item, src)
+        _apply_override(raw, *parse_override(item, src), src)
+    for key, value in (values or {}).items():
+        _apply_override(raw, key.split("."), value, src, how="")
     return from_dict(raw, src)
 
 
@@ -223,12 +242,11 @@ def parse_override(item: str, src: str = "--set") -> tuple[list[str], object]:
     return key.split("."), value
 
 
-def _apply_override(raw: dict, item: str, src: str) -> None:
-    parts, value = parse_override(item, src)
+def _apply_override(raw: dict, parts: list[str], value, src: str, how: str = "--set ") -> None:
     node, schema = raw, SCHEMA
     for i, part in enumerate(parts[:-1]):
         if not isinstance(schema, dict) or not isinstance(schema.get(part), dict):
-            raise SceneError(f"{src}: --set {'.'.join(parts[:i + 1])}: not a section"
+            raise SceneError(f"{src}: {how}{'.'.join(parts[:i + 1])}: not a section"
                              f"{hint(part, _sections(schema))}")
         schema = schema[part]
         node = node.setdefault(part, {})
@@ -253,9 +271,12 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     known = isinstance(system, str) and system in SYSTEMS  # else build() names the bad value
     schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
     d = v.build(v.merge(raw, schema, ""))
-    return Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
-                 Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
-                 source=src)
+    scene = Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
+                  Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
+                  d["compare"], source=src)
+    if scene.compare:
+        scene.variants()  # every variant's values are validated with the preset, before any work
+    return scene
 
 
 def _display(path: Path) -> str:

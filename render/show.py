@@ -341,7 +341,7 @@ def run(args) -> int:
     suggest = render_command(args)
     probe = check_display(suggest)  # before any compiling: a missing display fails at once
     try:
-        source = pipeline.Source(scene, arch=args.arch, threads=args.threads)
+        source = pipeline.open_source(scene, arch=args.arch, threads=args.threads)  # a comparison: split screen
         return play(source, scene.video.fps, args.out, suggest, on_open=probe.close)
     finally:
         probe.close()

@@ -10,12 +10,14 @@ Validator.build returns plain, validated sections; scene.from_dict turns them in
 from __future__ import annotations
 
 import difflib
+import json
 import math
 import re
 
 from . import grid, keys, registry
 from .errors import SceneError
 from .quality import LEVELS
+from .vary import PANEL_MIN, VARIANTS, VARYING, dotted, frozen, plain, vary_refusal
 
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
@@ -40,6 +42,7 @@ MAX_PIXELS = 3840 * 2160
 # The name becomes a folder and the files NAME.mp4 and .NAME.mp4.<owner>.<random>.part beside it; 100
 # characters keep every one of them far below the 255-byte limit of common file systems.
 NAME_MAX = 100
+NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.\-]*"  # letters, digits, _ . -, not starting with . or -
 DESCRIPTION_MAX = 1000  # free text shown in the gallery; longer is almost surely a mistake (a pasted file)
 # Common [pendulums] keys (each system declares its own in keys.py). Angles wrap, so beyond ±1000 rad a
 # spread only loses resolution (f64 resolves ~1e-13 rad there); gravity up to 1e4 m/s² (1000 g) and
@@ -53,6 +56,7 @@ DAMPING_MAX = 1e3
 F32_SIZE_MIN, F32_SIZE_MAX = 1e-3, 1e3
 
 REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+
 
 
 class Validator:
@@ -149,7 +153,7 @@ class Validator:
     def build(self, d: dict) -> dict:
         """The validated sections: name, description, system, effects, pendulums, integrator, video."""
         name = self.text(d["name"], "name", NAME_MAX)
-        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*", name):
+        if not re.fullmatch(NAME_PATTERN, name):
             self.fail("name", f"must be a file-name-safe string (letters, digits, _ . -), got {clip(repr(name))}")
         description = self.text(d["description"], "description", DESCRIPTION_MAX)
         system = self.choice(d["system"], "system", SYSTEMS)
@@ -171,7 +175,7 @@ class Validator:
             fractal = "angles"
         return {"name": name, "description": description, "system": system, "quality": quality,
                 "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
-                "fractal": fractal, "map": self.map(d, fractal)}
+                "fractal": fractal, "map": self.map(d, fractal), "compare": self.compare(d, pend, video, fractal)}
 
     def fractal(self, d, system) -> str | None:
         val = d["fractal"]
@@ -299,6 +303,55 @@ class Validator:
         if "glow" in eff and not any(e in eff for e in DRAWN):
             self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
+
+
+    def compare(self, d, pend, video, fractal) -> tuple | None:
+        """[compare] vary = { KEY = [V1, V2, ...], ... }: ((key, values), ...), the keys paired (value i of
+        each makes panel i). Each value is validated when the variants are built (Scene.variants)."""
+        table = d.get("compare")
+        if table is None:
+            return None
+        if fractal is not None:
+            self.fail("compare", "a fractal map fills its whole frame and cannot be split into panels; "
+                      "render each variant with --set instead")
+        if not isinstance(table, dict):
+            self.fail("compare", f"must be a table, got {tname(table)}")
+        for k in table:
+            if k != "vary":
+                self.fail(f"compare.{show_key(k)}", "unknown key" + hint(k, ["vary"], "compare."))
+        if "vary" not in table:
+            self.fail("compare.vary", "missing (this key is required)")
+        if not isinstance(table["vary"], dict) or not table["vary"]:
+            self.fail("compare.vary", f"must be a table of KEY = [V1, V2, ...], got {tname(table['vary'])}")
+        known = sorted(dotted({k: v for k, v in d.items() if k != "compare"}))
+        out = []
+        for key, values in dotted(table["vary"]).items():
+            name = f"compare.vary.{show_key(key)}"
+            if key not in known:  # hinted among the keys a comparison may vary
+                self.fail(name, "unknown key" + hint(key, [k for k in known if not vary_refusal(k)]))
+            why = vary_refusal(key)
+            if why:
+                self.fail(name, f"cannot vary: {why}; {VARYING}")
+            lo, hi = VARIANTS
+            if not isinstance(values, list) or not lo <= len(values) <= hi:
+                self.fail(name, f"must list {lo} to {hi} values (one per panel), got {clip(repr(values))}")
+            if not all(plain(v) for v in values):
+                self.fail(name, f"values are numbers, strings, booleans or lists of them (one value of {key} "
+                          f"each), got {clip(repr(values))}")
+            if out and len(values) != len(out[0][1]):
+                self.fail(name, f"lists {len(values)} values and {out[0][0]} lists {len(out[0][1])}: varied keys "
+                          f"are paired, one value per panel")
+            out.append((key, frozen(values)))
+        columns = list(zip(*(values for _, values in out)))
+        if len(set(columns)) != len(columns):
+            self.fail("compare.vary", f"two panels would be the same variant: {clip(json.dumps(columns))}")
+        if pend["layout"] == "grid":
+            self.fail("compare", "a grid (one pendulum per pixel) cannot be split into panels")
+        rows = 1 if len(columns) == 2 else 2
+        for key, size, parts in (("width", video["width"], 2), ("height", video["height"], rows)):
+            if size // parts < PANEL_MIN:
+                self.fail(f"video.{key}", f"{size} px split into {parts} panels leaves less than {PANEL_MIN} px each")
+        return tuple(out)
 
 
 _COUNT = {1: "one", 2: "two", 3: "three", 4: "four"}

@@ -34,6 +34,13 @@ def make_scene(system="rigid", count=1, **sections):
     return from_dict(raw, "<test>")
 
 
+def out_folder(out, name: str) -> Path:
+    """Where a render of preset `name` went: OUT/NAME/, or with --set or --quality its OUT/NAME__<hash>/."""
+    found = [p for p in Path(out).iterdir() if p.name == name or p.name.startswith(f"{name}__")]
+    assert len(found) == 1, found
+    return found[0]
+
+
 def run_cli(*args, cwd=None, timeout=300, **kw):
     """`python -m render ARGS` in a subprocess: the real exit code, stdout and stderr."""
     return subprocess.run([sys.executable, "-m", "render", *map(str, args)], capture_output=True, text=True,

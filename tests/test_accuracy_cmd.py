@@ -9,7 +9,7 @@ from render import registry
 from render.accuracy import COLUMNS
 from render.scene import METHODS
 
-THEORY = {"symplectic_euler": 1, "verlet": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
+THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_precision", "energy_drift")),
         "divergence.png", "work_precision_rigid_chaos.png", "faithful_rigid_chaos.png")
 

@@ -120,6 +120,7 @@ def test_good_preset_is_accepted_by_the_same_path(tmp_path, capsys):
     (["render", "classic", "--quality", "ultra"], ["--quality", "ultra"]),
     (["render", "classic", "--out", "/proc/pendulum-out"], ["--out", "/proc/pendulum-out", "not a writable"]),
     (["simulate", "classic", "--out", "x.csv"], ["--out", "x.csv", ".npz"]),
+    (["gallery", "--out", "no_renders_here"], ["--out", "no_renders_here", "not a directory"]),
     (["frobnicate"], ["frobnicate"]),
 ])
 def test_bad_command_lines_in_a_real_process(tmp_path, args, needles):

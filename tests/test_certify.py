@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import make_scene, run_cli
+from conftest import make_scene, out_folder, run_cli
 from render import certify, pipeline, quality, reference, runtime
 from render.scene import load
 
@@ -58,7 +58,7 @@ def test_metadata_and_the_last_line_carry_the_certificate_and_the_quality(tmp_pa
     r = run_cli("render", "rigid_chaos", "--set", "video.duration=1", "--set", "video.width=160",
                 "--set", "video.height=90", "--out", tmp_path, "--no-progress")
     assert r.returncode == 0, r.stderr
-    meta = json.loads((tmp_path / "rigid_chaos" / "metadata.json").read_text())
+    meta = json.loads((out_folder(tmp_path, "rigid_chaos") / "metadata.json").read_text())
     f = meta["faithfulness"]
     assert f["shadow"]["precision"] == "f64" and f["tolerance"] == 1e-3 and f["unit"] == "rad"
     assert f["faithful_until_s"] == f["median_until_s"] == 1.0 and f["fraction_faithful"] == 1.0

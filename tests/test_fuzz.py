@@ -22,7 +22,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import run_cli
+from conftest import out_folder, run_cli
 from render import batch, budget, cli, pipeline, registry, runtime
 from render.errors import SceneError
 from render.scene import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SCHEMA, SYSTEMS
@@ -295,7 +295,8 @@ def test_valid_extremes_render_for_real_or_are_refused(tmp_path, monkeypatch, se
     code, err = run_main(argv)
     assert_contract(code, err, list((tmp_path / "out").rglob("*")) if code == 2 else [], argv)
     if code == 0:
-        assert (tmp_path / "out" / "edge" / "edge.mp4").stat().st_size > 0
+        folder = out_folder(tmp_path / "out", "edge")
+        assert (folder / f"{folder.name}.mp4").stat().st_size > 0
 
 
 # ------------------------------------------------------------------ a few as real processes

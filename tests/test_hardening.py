@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, out_folder, run_cli
 
 ADDRESS_SPACE = 8 << 30  # bytes
 TINY = ["--set", "video.width=32", "--set", "video.height=32", "--set", "video.duration=0.2", "--no-progress"]
@@ -130,7 +130,7 @@ def test_two_presets_with_the_same_name_are_refused_naming_both(tmp_path):
 def test_a_file_where_the_render_folder_goes_is_refused(tmp_path):
     (tmp_path / "out").mkdir()
     (tmp_path / "out" / "classic").write_text("mine")
-    r = run_user("render", "classic", "--out", "out", *TINY, cwd=tmp_path)
+    r = run_user("render", "classic", "--out", "out", "--no-progress", cwd=tmp_path)  # no --set: out/classic
     one_line(r, 2, "--out", "classic is a file")
     assert [p.name for p in (tmp_path / "out").iterdir()] == ["classic"]
     assert (tmp_path / "out" / "classic").read_text() == "mine"
@@ -149,7 +149,8 @@ def test_no_gravity_is_a_still_pendulum(tmp_path):
     np.testing.assert_allclose(theta[0, 0], [math.radians(120), math.radians(-10)])
     r = run_user("render", "classic", "--out", "out", *TINY, "--set", "pendulums.gravity=0", cwd=tmp_path)
     assert r.returncode == 0 and not r.stderr.strip(), r.stderr
-    assert (tmp_path / "out" / "classic" / "classic.mp4").stat().st_size > 0
+    folder = out_folder(tmp_path / "out", "classic")
+    assert (folder / f"{folder.name}.mp4").stat().st_size > 0
 
 
 def test_simulate_to_a_full_disk_fails_with_one_line_and_leaves_nothing(tmp_path):
@@ -188,9 +189,9 @@ def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
 
 def test_a_render_killed_with_sigkill_leaves_parts_that_the_next_render_sweeps(tmp_path):
     slow = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
-                             "--no-progress", "--set", "video.width=320", "--set", "video.height=180"],
-                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    target = tmp_path / "rigid_chaos"
+                             "--no-progress", "--set", "video.width=320", "--set", "video.height=180",
+                             "--name", "killed"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    target = tmp_path / "killed"  # named: the next render, with other --set, writes into the same folder
     deadline = time.time() + 120
     while len(list(target.glob(".*.part"))) < 2 and time.time() < deadline:  # MP4 and GIF under way
         time.sleep(0.05)
@@ -199,10 +200,10 @@ def test_a_render_killed_with_sigkill_leaves_parts_that_the_next_render_sweeps(t
     left = list(target.glob(".*.part"))
     assert len(left) == 2, left  # what SIGKILL leaves: nothing could clean up
 
-    r = run_user("render", "rigid_chaos", "--out", tmp_path, *TINY, cwd=tmp_path)
+    r = run_user("render", "rigid_chaos", "--out", tmp_path, *TINY, "--name", "killed", cwd=tmp_path)
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     assert not list(tmp_path.rglob("*.part")), list(tmp_path.rglob("*.part"))
-    assert (target / "rigid_chaos.mp4").stat().st_size > 0
+    assert (target / "killed.mp4").stat().st_size > 0
 
 
 def test_another_live_writers_parts_are_left_alone(tmp_path):

@@ -11,7 +11,7 @@ from render import accuracy, reference, runtime
 from render.pipeline import make_system
 from render.scene import METHODS
 
-THEORY = {"symplectic_euler": 1, "verlet": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
+THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 # In the asymptotic regime for every method, and above the reference's ~1e-12 error even for rk4.
 LADDER = (4e-3, 2e-3, 1e-3)
 CASES = [(s, m) for s in ("rigid", "elastic") for m in METHODS[s]]

@@ -6,7 +6,7 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import out_folder, run_cli
 from render import pipeline
 from render.scene import list_presets, load
 
@@ -34,7 +34,7 @@ def rendered(tmp_path_factory):
     for name in PRESETS:
         raw = {}
         meta = pipeline.render(short(name), out, frame_hook=lambda f, fr: raw.setdefault(f, fr.copy()))
-        results[name] = (out / name, meta, raw[0])
+        results[name] = (short(name).out_dir(out), meta, raw[0])  # a comparison: out/compare/NAME/
     return results
 
 
@@ -132,6 +132,6 @@ def test_cuda_request_falls_back_to_cpu_with_one_warning(tmp_path):
     r = run_cli("render", "classic", "--arch", "cuda", "--out", tmp_path, "--set", "video.duration=0.1",
                 "--set", "video.width=64", "--set", "video.height=48")
     assert r.returncode == 0, r.stderr
-    meta = json.loads((tmp_path / "classic" / "metadata.json").read_text())
+    meta = json.loads((out_folder(tmp_path, "classic") / "metadata.json").read_text())
     if meta["arch"] == "cpu":  # no GPU here (CI): exactly one clear warning
         assert r.stderr.count("warning: --arch cuda") == 1

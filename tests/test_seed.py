@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from conftest import run_cli
+from conftest import out_folder, run_cli
 
 SHORT = ["--set", "video.duration=0.3", "--set", "video.width=160", "--set", "video.height=90", "--no-progress"]
 
@@ -13,7 +13,7 @@ SHORT = ["--set", "video.duration=0.3", "--set", "video.width=160", "--set", "vi
 def render(tmp_path, preset, *args):
     r = run_cli("render", preset, *SHORT, *args, "--out", tmp_path)
     assert r.returncode == 0, r.stderr
-    return json.loads((tmp_path / preset / "metadata.json").read_text()), r
+    return json.loads((out_folder(tmp_path, preset) / "metadata.json").read_text()), r
 
 
 def test_seed_rigid_has_the_talks_values(tmp_path):

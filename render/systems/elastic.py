@@ -18,7 +18,7 @@ class Elastic(System):
     # Young's-modulus-like E, as in the seed. Within [1e-6, 1e12]: the spring constants k = E/l this gives
     # with lengths in [1e-6, 1e6] stay finite in f32; how fast a stiff spring makes the step is budget.py's.
     KEYS = {"stiffness": Real(2e3, 1e-6, 1e12)}
-    METHODS = ("symplectic_euler", "rk4", "verlet", "yoshida4")
+    METHODS = ("symplectic_euler", "rk2", "rk4", "verlet", "yoshida4")
     DEFAULT_EFFECTS = ("springs", "bobs", "trails", "energy")
     STATE = {"pos": ("q", (2, 2)), "vel": ("v", (2, 2))}
     REFERENCE = "springs"

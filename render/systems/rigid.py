@@ -13,7 +13,7 @@ class Rigid(System):
     D = 2  # q = (θ1, θ2), v = (ω1, ω2)
     LINKS = ("rod", "rod")
     ANGLES = True
-    METHODS = ("symplectic_euler", "rk4", "implicit_midpoint")
+    METHODS = ("symplectic_euler", "rk2", "rk4", "implicit_midpoint")
     DEFAULT_EFFECTS = ("rods", "bobs", "trails", "energy")
     STATE = {"theta": ("q", (2,)), "omega": ("v", (2,))}
     REFERENCE = "chain"

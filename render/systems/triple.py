@@ -18,7 +18,7 @@ class Triple(System):
     D = 3  # q = (θ1, θ2, θ3), v = (ω1, ω2, ω3)
     LINKS = ("rod", "rod", "rod")
     ANGLES = True
-    METHODS = ("symplectic_euler", "rk4", "implicit_midpoint")
+    METHODS = ("symplectic_euler", "rk2", "rk4", "implicit_midpoint")
     DEFAULT_EFFECTS = ("rods", "bobs", "trails", "energy")
     STATE = {"theta": ("q", (3,)), "omega": ("v", (3,))}
     REFERENCE = "chain"

@@ -1,0 +1,122 @@
+"""The Python API: `load`, `render`, `simulate` and `compare`. The CLI is a thin layer over it.
+
+Every check the command line makes before any work lives here, so a notebook gets the same refusals as a
+shell: bad input raises SceneError (the CLI's exit 2) before anything is written, a failure while running
+raises SimulationError or EncodeError (exit 1), the file system's errors are OSErrors naming the file.
+
+    import render
+    scene = render.load("classic", **{"video.duration": 2}, video={"width": 640, "height": 360})
+    result = render.render(scene, out="out")      # a RenderResult: paths, metadata, certificate
+    traj = render.simulate(scene)                 # a Trajectory: t, theta/omega or pos/vel, energy
+    both = render.compare("rigid_chaos", vary={"integrator.precision": ["f32", "f64"]})  # a split screen
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from . import budget, comparison, pipeline, registry, scene as scenes
+from .errors import SceneError
+from .options import check_writable
+from .results import RenderResult, Trajectory
+
+
+def load(preset: str | os.PathLike, /, *settings: str, quality: str | None = None, **overrides) -> scenes.Scene:
+    """The frozen, validated Scene of a preset (a name on the preset search path, or a .toml file).
+
+    Overrides are dotted keys, `load("classic", **{"video.duration": 2})`, or nested dicts,
+    `load("classic", video={"duration": 2})`; `settings` are strings as `--set` takes them
+    ("video.duration=2", the value in TOML). `quality` is a --quality level (draft, standard, high, reference).
+    """
+    values = {}
+    for key, value in overrides.items():
+        _flatten(key, value, values)
+    return scenes.load(os.fspath(preset), settings, quality, values)
+
+
+def _flatten(key: str, value, out: dict) -> None:
+    """video={"duration": 2} -> out["video.duration"] = 2; numpy scalars and arrays, tuples as plain TOML
+    values (the validator checks types as TOML gives them)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _flatten(f"{key}.{k}", v, out)
+        return
+    out[key] = _plain(value)
+
+
+def _plain(value):
+    if hasattr(value, "tolist") and callable(value.tolist):  # numpy scalar or array
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _scene(scene) -> scenes.Scene:
+    return scene if isinstance(scene, scenes.Scene) else load(scene)
+
+
+def check_render(scene_list, out: Path) -> None:
+    """Refuse (SceneError) before any work: an output root that cannot be written, a NAME there that is a
+    file, a scene over the budget."""
+    out = Path(out)
+    check_writable(out)
+    for scene in scene_list:
+        folder = scene.out_dir(out)
+        if folder.exists() and not folder.is_dir():
+            raise SceneError(f"--out {out}: {folder} is a file; {scene.name} renders into a folder of that name")
+        budget.check(scene, registry.get(scene.system), out)
+
+
+def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads: int | None = None,
+           progress: bool = False) -> RenderResult:
+    """Render a Scene (or a preset name) into OUT/NAME/: MP4 and GIF as the scene's formats say, and
+    metadata.json. Returns the paths, the metadata and the faithfulness certificate."""
+    scene = _scene(scene)
+    out = Path(out)
+    check_render([scene], out)
+    meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
+    return RenderResult(scene, scene.out_dir(out), meta)
+
+
+def check_npz(out: Path, name: str) -> None:
+    """Refuse (SceneError) a trajectory file that cannot be written, before any work."""
+    if out.suffix != ".npz":
+        raise SceneError(f"--out {out}: must end in .npz")
+    if out.is_dir():
+        raise SceneError(f"--out {out}: is a directory; give the file to write, e.g. {out / name}.npz")
+    check_writable(out.parent)
+
+
+def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
+             progress: bool = False) -> Trajectory:
+    """Simulate a Scene (or a preset name) without drawing: the state at every frame time, as the .npz of
+    `pendulum simulate` holds it. Nothing is written unless `out` names a .npz file."""
+    scene = _scene(scene)
+    out = Path(out) if out is not None else None
+    if out is not None:
+        check_npz(out, scene.name)
+    budget.check(scene, registry.get(scene.system), out.parent if out is not None else None, simulate=True)
+    try:
+        info = pipeline.simulate(scene, out, arch=arch, progress=progress)
+    except OSError as e:  # e.g. a full disk while writing: numpy's error does not say which file
+        if out is not None and e.filename is None and e.strerror:
+            raise OSError(e.errno, e.strerror, str(out)) from e
+        raise
+    return Trajectory(scene, info.pop("arrays", {}), info, out)
+
+
+def compare(scene, vary: dict | None = None, out: str | os.PathLike = "out", *, arch: str = "cpu",
+            threads: int | None = None, progress: bool = False) -> RenderResult:
+    """The split-screen comparison `pendulum compare` renders: `vary` maps dotted keys to one value per panel
+    (2 to 4), paired key by key, e.g. {"integrator.precision": ["f32", "f64"]}; without it, the preset's own
+    [compare] table. Writes OUT/compare/NAME/; the result's metadata has every variant under "compare"."""
+    scene = _scene(scene)
+    if vary is not None:
+        values = {}
+        for key, val in vary.items():
+            _flatten(key, val, values)
+        scene = comparison.with_table(scene, values)
+    elif not scene.compare:
+        raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give vary={{KEY: [V1, V2]}}")
+    return render(scene, out, arch=arch, threads=threads, progress=progress)

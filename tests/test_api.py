@@ -1,0 +1,165 @@
+"""The Python API (render/api.py): load's overrides, render's and simulate's results, their errors, and how
+the results display in a notebook (_repr_html_)."""
+import base64
+import html.parser
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import render
+from render.errors import SceneError, SimulationError
+
+SMALL = {"video.duration": 1, "video.fps": 20}  # 20 frames: every path of a render, in seconds
+FRAME = {"width": 160, "height": 90}
+
+
+class Media(html.parser.HTMLParser):
+    """The <video> and <img> elements of an HTML fragment and their src."""
+
+    def __init__(self):
+        super().__init__()
+        self.media = []
+
+    def handle_starttag(self, tag, attrs):
+        if tag in ("video", "img"):
+            self.media.append((tag, dict(attrs).get("src")))
+
+
+def media_of(page: str) -> list[tuple[str, str]]:
+    p = Media()
+    p.feed(page)
+    return p.media
+
+
+def test_import_render_starts_no_taichi():
+    code = ("import sys, render; assert 'taichi' not in sys.modules, 'taichi'; "
+            "assert {'load', 'render', 'simulate'} <= set(dir(render)); print(render.__version__)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.strip() == render.__version__, r.stderr
+
+
+def test_load_takes_dotted_keys_nested_dicts_and_set_strings():
+    dotted = render.load("classic", **{"video.duration": 2, "pendulums.lengths": [1.0, 0.5]})
+    nested = render.load("classic", video={"duration": 2}, pendulums={"lengths": (1.0, 0.5)})
+    settings = render.load("classic", "video.duration=2", "pendulums.lengths=[1.0, 0.5]")
+    assert dotted == nested == settings
+    assert dotted.video.duration == 2 and dotted.pendulums.lengths == (1.0, 0.5)
+    assert dotted.frames == 120 and dotted.name == "classic"
+    assert render.load("classic", video={"fps": np.int64(30)}).video.fps == 30  # numpy scalars are plain values
+    with pytest.raises(AttributeError):  # the Scene is frozen
+        dotted.name = "x"
+
+
+@pytest.mark.parametrize("kwargs, needles", [
+    ({"video.fsp": 10}, ["classic.toml", "video.fsp", "did you mean 'video.fps'"]),
+    ({"video": {"duration": -1}}, ["classic.toml", "video.duration"]),
+    ({"name": {"x": 1}}, ["classic.toml", "name: not a section"]),
+    ({"quality": "superb"}, ["classic.toml", "unknown level 'superb'"]),
+])
+def test_load_refuses_bad_overrides_naming_file_and_key(kwargs, needles):
+    quality = kwargs.pop("quality", None)
+    with pytest.raises(SceneError) as e:
+        render.load("classic", quality=quality, **kwargs)
+    assert all(n in str(e.value) for n in needles), str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_an_unknown_preset_is_a_scene_error():
+    with pytest.raises(SceneError, match="no such preset.*did you mean 'classic'"):
+        render.load("clasic")
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    out = tmp_path_factory.mktemp("api") / "renders"
+    scene = render.load("classic", **SMALL, video=FRAME)
+    return scene, out, render.render(scene, out=out)
+
+
+def test_render_returns_paths_metadata_and_certificate(rendered):
+    scene, out, result = rendered
+    assert result.dir == out / "classic"
+    assert set(result.paths) == {"mp4", "gif", "metadata"} and all(p.is_file() for p in result.paths.values())
+    assert result.metadata == json.loads(result.paths["metadata"].read_text())
+    assert result.certificate == result.metadata["faithfulness"] and result.certificate["fraction_faithful"] == 1.0
+    assert result.frames == scene.frames == 20
+    assert result.line().startswith("classic: 20 frames 160x90@20 | rk4")
+
+
+def test_render_result_displays_its_video_and_a_table(rendered, monkeypatch):
+    _, out, result = rendered
+    monkeypatch.chdir(out.parent)  # Jupyter resolves a relative src against the notebook's folder, its cwd
+    page = result._repr_html_()
+    assert media_of(page) == [("video", "renders/classic/classic.mp4")]
+    assert (out.parent / "renders/classic/classic.mp4").is_file()
+    for needle in ("frames", "20 (160x90 at 20 fps", "method", "rk4", "faithful until the end", "wall time"):
+        assert needle in page, needle
+
+
+def test_a_gif_only_render_embeds_the_gif_when_small(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = render.render(render.load("classic", **SMALL, video={**FRAME, "formats": ["gif"]}), out="o")
+    assert set(result.paths) == {"gif", "metadata"}
+    [(tag, src)] = media_of(result._repr_html_())
+    assert tag == "img" and src.startswith("data:image/gif;base64,")
+    assert base64.b64decode(src.split(",", 1)[1]) == result.paths["gif"].read_bytes()
+    monkeypatch.setattr("render.results.EMBED_BYTES", 10)  # a large GIF is linked, not embedded
+    [(tag, src)] = media_of(result._repr_html_())
+    assert tag == "img" and src == "o/classic/classic.gif" and Path(src).is_file()
+
+
+def test_render_refuses_before_any_work(tmp_path):
+    (tmp_path / "classic").write_text("a file where the render's folder goes")
+    with pytest.raises(SceneError, match="is a file"):
+        render.render(render.load("classic", **SMALL), out=tmp_path)
+    with pytest.raises(SceneError, match="not a writable directory"):
+        render.render(render.load("classic", **SMALL), out=tmp_path / "classic" / "below")
+    assert [p.name for p in tmp_path.iterdir()] == ["classic"]
+
+
+def test_simulate_returns_the_arrays_the_npz_holds(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    scene = render.load("classic", **SMALL)
+    traj = render.simulate(scene)
+    assert not any(tmp_path.iterdir())  # no file unless asked
+    assert list(traj) == ["t", "energy", "theta", "omega"] and traj.path is None
+    assert traj.theta.shape == traj.omega.shape == (20, 1, 2) and traj.energy.shape == (20, 1)
+    assert traj["t"][0] == 0 and traj.t[-1] == pytest.approx(0.95)
+    assert all(v.dtype == np.float64 for v in traj.values())
+    written = render.simulate(scene, out="t.npz")
+    assert written.path == Path("t.npz")
+    with np.load("t.npz") as npz:
+        assert sorted(npz.files) == sorted(traj) and all(np.array_equal(npz[k], traj[k]) for k in traj)
+    page = traj._repr_html_()
+    assert "<table>" in page and "theta 20x1x2" in page and "not written" in page
+    assert traj.energy_drift() < 1e-6 and traj.certificate["fraction_faithful"] == 1.0
+
+
+def test_simulate_errors_are_the_clis_typed_exceptions(tmp_path):
+    with pytest.raises(SceneError, match="must end in .npz"):
+        render.simulate(render.load("classic", **SMALL), out=tmp_path / "t.csv")
+    untrue = render.load("classic", **{"integrator.method": "symplectic_euler", "pendulums.lengths": [1.0, 0.1],
+                                       "video.duration": 10})
+    with pytest.raises(SimulationError, match="min_faithful=0"):  # the faithfulness watchdog: exit 1 in the CLI
+        render.simulate(untrue, out=tmp_path / "t.npz")
+    assert not any(tmp_path.iterdir())
+
+
+def test_compare_renders_the_split_screen_and_refuses_what_cannot_vary(tmp_path):
+    small = {**SMALL, "video.width": 256, "video.height": 144}
+    scene = render.load("rigid_chaos", **small, **{"pendulums.count": 4})
+    result = render.compare(scene, vary={"integrator.precision": ["f32", "f64"]}, out=tmp_path)
+    assert result.dir == tmp_path / "compare" / "rigid_chaos" and result.paths["mp4"].is_file()
+    variants = result.metadata["compare"]["variants"]
+    assert [v["integrator"]["precision"] for v in variants] == ["f32", "f64"]
+    assert "rigid_chaos" in result.line() and str(result.dir) in result.line()
+    with pytest.raises(SceneError, match="video.fps"):
+        render.compare(scene, vary={"video.fps": [10, 20]}, out=tmp_path / "no")
+    with pytest.raises(SceneError, match="no \\[compare\\] table"):
+        render.compare(scene, out=tmp_path / "no")
+    assert not (tmp_path / "no").exists()
+    assert callable(render.compare)  # the function, not a module of that name
