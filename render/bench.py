@@ -30,9 +30,9 @@ FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fra
 SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the first gives the headline figure
 # fractal_s: seconds of each map rendered (None: the preset's own). A flip map speeds up as pixels flip and
 # stop, so it is timed over its whole 20 s; the others cost about the same every frame, so 2 s tell.
-FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None,
+FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None, "peer_s": 10.0,
         "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": 2.0}}
-QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "min_s": 0.1, "rainbow_s": 3.0,
+QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "min_s": 0.1, "rainbow_s": 3.0, "peer_s": 1.0,
          "fractal_s": {"angles": 0.1, "flip_time": 0.1, "divergence": 0.1}}  # a smoke run: 6 frames each
 TARGETS = [("end_to_end_over_encode_floor", "<=", 1.3), ("sim_speedup_vs_numpy_1e5", ">=", 15.0),  # 10 in issue 8
            ("fractal_fps.flip_time", ">=", 5.0), ("fractal_peak_mem_mb", "<", 2048.0),  # issues 8 and 16
@@ -288,8 +288,16 @@ def canvas_frame(scene) -> np.ndarray:
     return np.zeros((scene.video.height, scene.video.width, 3), np.uint8)
 
 
+def phase_matplotlib(cfg, arch, tmp) -> dict:
+    """rigid_chaos to MP4 by our render and by the matplotlib FuncAnimation peer, the same frames (issue 17)."""
+    from .scene import load
+    scene = load(CHAOS, [f"video.duration={cfg['peer_s']}", 'video.formats=["mp4"]'])
+    ours, _ = timed_render(scene, arch, tmp, scene.replace(video={"duration": 1.0 / scene.video.fps}))
+    return {"frames": scene.frames, "ours_s": ours, "matplotlib_s": peers.matplotlib_render(scene, tmp / "mpl.mp4")}
+
+
 PHASES = {"sim": phase_sim, "encode": phase_encode, "e2e": phase_e2e, "rainbow": phase_rainbow,
-          **{f"fractal_{c}": functools.partial(phase_fractal, c) for c in FRACTALS}}
+          **{f"fractal_{c}": functools.partial(phase_fractal, c) for c in FRACTALS}, "matplotlib": phase_matplotlib}
 
 
 # ---------------------------------------------------------------- report
@@ -313,7 +321,8 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
            "end_to_end_s": e2e["wall_s"], "encode_floor_s": enc["floor_s"], "frames": e2e["frames"],
            "end_to_end_fixed_s": e2e["fixed_s"], "end_to_end_timings": e2e["timings"], "fractal": fr,
            "sim": res["sim"]["rows"], "peak_mem_mb": {k: v["peak_mem_mb"] for k, v in res.items()}, "targets": {},
-           **peers.throughput_keys(res["sim"]["rows"], e2e["wall_s"], (QUICK if quick else FULL)["chaos_s"]),
+           **peers.throughput_keys(res["sim"]["rows"], e2e["wall_s"], (QUICK if quick else FULL)["chaos_s"],
+                                   res["matplotlib"]), "matplotlib_peer": res["matplotlib"],
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING}}
     for key, op, goal in TARGETS:
         val = functools.reduce(lambda d, k: d[k], key.split("."), rep)  # "fractal_fps.flip_time"

@@ -1,4 +1,4 @@
-"""The numba peer of `pendulum bench`, and the throughput keys of issue 17 that it and the numpy peer give.
+"""The numba and matplotlib peers of `pendulum bench`, and the throughput keys of issue 17 they give.
 
 The peer is what a user would write in one page: @njit(parallel=True, fastmath=True), a prange over the
 pendulums, RK4 with the state in locals, math.sin / math.cos. It is an independent implementation of the
@@ -107,9 +107,9 @@ def numba_rk4(scene, dtype):
     return advance_elastic
 
 
-def throughput_keys(rows: list[dict], render_s: float, video_s: float) -> dict:
-    """Issue 17's report keys from the sim phase's rows at N = 1e5 and the timed rigid_chaos render; a ratio
-    against a peer that did not run (numba missing) is null. The rows come in bench.SIM_PRESETS' order: the
+def throughput_keys(rows: list[dict], render_s: float, video_s: float, mpl: dict | None = None) -> dict:
+    """Issue 17's report keys from the sim phase's rows at N = 1e5, the timed rigid_chaos render and the
+    matplotlib phase; a ratio against a peer that did not run (numba missing) is null. The rows come in bench.SIM_PRESETS' order: the
     rigid pendulum's system first, then the elastic one's."""
     rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
     at = {(r["system"], r["precision"]): r for r in rows if r["n"] == 10**5}
@@ -123,7 +123,7 @@ def throughput_keys(rows: list[dict], render_s: float, video_s: float) -> dict:
             "elastic_speedup_vs_numpy_1e5": ratio(elastic, "numpy"),
             "elastic_speedup_vs_numba_1e5": ratio(elastic, "numba"),
             "render_over_realtime": render_s / video_s,
-            "matplotlib_peer_ratio": None}  # no matplotlib FuncAnimation peer in the code base yet
+            "matplotlib_peer_ratio": mpl["matplotlib_s"] / mpl["ours_s"] if mpl else None}
 
 
 def numba_rate(scene, q, v, h: float, n: int, min_s: float, rate) -> float | None:
@@ -144,3 +144,61 @@ def numba_rate(scene, q, v, h: float, n: int, min_s: float, rate) -> float | Non
 
 
 _said: list = []
+
+
+def matplotlib_render(scene, out_file) -> float:
+    """The matplotlib peer: the scene's frames as a user would make them, a FuncAnimation over numpy RK4
+    (render/reference.py) drawing rods, bobs and 1 s trails with Agg at the scene's size, saved as MP4 by
+    ffmpeg at this project's x264 settings. Returns its wall time in s (simulation included)."""
+    import time
+
+    import imageio_ffmpeg
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.animation import FFMpegWriter, FuncAnimation
+    from matplotlib.collections import LineCollection
+
+    from . import reference, registry
+    from .encode import MP4_CRF, MP4_PRESET
+
+    t0 = time.perf_counter()
+    plan = registry.get(scene.system)(scene, allocate=False)  # the step and the initial state, no Taichi
+    q, v = (a.T.copy() for a in reference.initial_state(scene))
+    v_ = scene.video
+    matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
+    fig = plt.figure(figsize=(v_.width / 100, v_.height / 100), dpi=100, facecolor="black")
+    ax = fig.add_axes((0, 0, 1, 1), facecolor="black")
+    reach = 1.1 * plan.reach()
+    ax.set_xlim(-reach * v_.width / v_.height, reach * v_.width / v_.height)
+    ax.set_ylim(-reach, reach)
+    ax.set_axis_off()
+    colours = plt.cm.viridis(np.linspace(0, 1, plan.n))
+    rods = LineCollection([], colors=colours, linewidths=1.5)
+    trails = LineCollection([], colors=colours, linewidths=1.0, alpha=0.5)
+    ax.add_collection(trails)
+    ax.add_collection(rods)
+    links = len(plan.LINKS)
+    bobs = ax.scatter(np.zeros(plan.n * links), np.zeros(plan.n * links), s=12, c=np.repeat(colours, links, 0))
+    history = []
+
+    def frame(f):
+        nonlocal q, v
+        if f:
+            for _ in range(plan.substeps):
+                q, v = reference.rk4_step(scene, q, v, plan.h)
+        pts = reference.bob_positions(scene, q.T)  # (N, bobs, 2)
+        chain = np.concatenate([np.zeros((len(pts), 1, 2)), pts], axis=1)
+        history.append(pts[:, -1])
+        del history[:-max(2, int(v_.fps * v_.trail_seconds))]
+        rods.set_segments(chain)
+        trails.set_segments(np.stack(history, axis=1))
+        bobs.set_offsets(pts.reshape(-1, 2))
+        return rods, trails, bobs
+
+    writer = FFMpegWriter(fps=v_.fps, codec="libx264",
+                          extra_args=["-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p"])
+    FuncAnimation(fig, frame, frames=scene.frames, blit=False).save(str(out_file), writer=writer, dpi=100)
+    plt.close(fig)
+    return time.perf_counter() - t0
