@@ -45,3 +45,36 @@ def run_cli(*args, cwd=None, timeout=300, **kw):
     """`python -m render ARGS` in a subprocess: the real exit code, stdout and stderr."""
     return subprocess.run([sys.executable, "-m", "render", *map(str, args)], capture_output=True, text=True,
                           cwd=cwd or ROOT, timeout=timeout, **kw)
+
+
+# Every preset rendered once, small and short, for both the goldens (tests/test_golden.py: raw frames) and the
+# decode-back checks (tests/test_render.py: the MP4, the GIF and metadata.json): compiling each preset's
+# kernels is most of a render's cost here, so one render serves both.
+SMALL_W, SMALL_H, SMALL_FPS, SMALL_SECONDS = 256, 144, 10, 3.0
+PICKS = {"first": 0, "early": 5, "later": 29}  # t = 0, 0.5 s, 2.9 s: well before f64 round-off matters
+
+
+def small_scene(name):
+    from render.scene import load
+    return load(name, [f"video.width={SMALL_W}", f"video.height={SMALL_H}", f"video.fps={SMALL_FPS}",
+                       f"video.duration={SMALL_SECONDS}", 'video.formats=["mp4", "gif"]'])
+
+
+def render_small(name, out, threads=None):
+    """(folder, metadata, raw frames at PICKS) of the small render of preset `name` into OUT."""
+    from render import pipeline
+    scene, frames, want = small_scene(name), {}, {v: k for k, v in PICKS.items()}
+    meta = pipeline.render(scene, out, threads=threads,
+                           frame_hook=lambda f, fr: frames.__setitem__(want[f], fr.copy()) if f in want else None)
+    return scene.out_dir(out), meta, frames  # a comparison goes to OUT/compare/NAME/
+
+
+@pytest.fixture(scope="session")
+def preset_renders(tmp_path_factory):
+    from render import split
+    from render.scene import list_presets
+    out = tmp_path_factory.mktemp("presets")
+    with pytest.MonkeyPatch.context() as mp:
+        # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.
+        mp.setattr(split, "cost", lambda run: 1e-3 * split.integrators.ORDER[run["integrator"]["method"]])
+        return {p.stem: render_small(p.stem, out) for p in list_presets()}

@@ -10,31 +10,19 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from render import pipeline, split
-from render.scene import list_presets, load
+from conftest import PICKS, render_small
+from render.scene import list_presets
 
 GOLDEN = Path(__file__).parent / "golden"
 DIFFS = Path(__file__).resolve().parent.parent / "out" / "golden-diffs"
-W, H, FPS, SECONDS = 256, 144, 10, 3.0
-PICKS = {"first": 0, "early": 5, "later": 29}  # t = 0, 0.5 s, 2.9 s: well before f64 round-off matters
 ATOL = 2
 MAX_BAD_FRACTION = 1e-3
 PRESETS = [p.stem for p in list_presets()]
 
 
-def small_scene(name):
-    sets = [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", f"video.duration={SECONDS}",
-            'video.formats=["mp4"]']
-    return load(name, sets)
-
-
 def raw_frames(name, out, threads=None):
     """The raw frames PICKS names, as rendered (encoding too, since that is the code path users run)."""
-    frames = {}
-    want = {v: k for k, v in PICKS.items()}
-    pipeline.render(small_scene(name), out, threads=threads,
-                    frame_hook=lambda f, fr: frames.__setitem__(want[f], fr.copy()) if f in want else None)
-    return frames
+    return render_small(name, out, threads)[2]
 
 
 def compare(expected: np.ndarray, actual: np.ndarray, label: str):
@@ -58,12 +46,8 @@ def compare(expected: np.ndarray, actual: np.ndarray, label: str):
 
 
 @pytest.fixture(scope="module")
-def rendered(tmp_path_factory):
-    out = tmp_path_factory.mktemp("golden")
-    with pytest.MonkeyPatch.context() as mp:
-        # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.
-        mp.setattr(split, "cost", lambda run: 1e-3 * split.integrators.ORDER[run["integrator"]["method"]])
-        return {name: raw_frames(name, out) for name in PRESETS}
+def rendered(preset_renders):
+    return {name: frames for name, (_, _, frames) in preset_renders.items()}
 
 
 @pytest.mark.parametrize("name", PRESETS)
