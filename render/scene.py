@@ -47,7 +47,7 @@ SCHEMA: dict[str, object] = {
     "compare": None,  # a comparison: [compare] vary = { KEY = [V1, V2, ...] } (validate.py, split.py)
     "pendulums": pendulum_keys(None),
     "integrator": {
-        "method": "rk4", "dt": "auto", "precision": "f64",
+        "method": "rk4", "dt": "auto", "precision": "f64", "trig": "inline",
         "allow_unstable": False, "max_drift": None, "tolerance": 1e-3, "min_faithful": 0.1,
     },
     "video": {
@@ -84,6 +84,7 @@ class Integrator:
     method: str
     dt: "float | str"
     precision: str
+    trig: str  # "inline": render/sincos.py (vectorises); "libm": the C library's, bit for bit as the seed ran
     allow_unstable: bool
     max_drift: float | None
     tolerance: float  # faithfulness: rad on any angle, or a fraction of the total length for positions
@@ -151,7 +152,10 @@ class Scene:
         return json.loads(json.dumps(d))  # tuples to lists: the same dict metadata.json reads back as
 
     def hash(self) -> str:
-        blob = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+        d = self.to_dict()
+        if d["integrator"]["trig"] == "inline":  # the default of a key added later: scenes keep their hash
+            del d["integrator"]["trig"]
+        blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
     def out_dir(self, root: Path) -> Path:

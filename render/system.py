@@ -4,7 +4,7 @@ kernels, the drawing contract and the watchdog.
 A system module (render/systems/) subclasses System, declares what the registry and the scene loader need as
 class attributes, and writes its physics once as Taichi functions:
 - accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group of LANES), so the
-  same code runs one pendulum or several packed side by side;
+  same code runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
 - energy(q, v) and points(q) for one pendulum's vectors.
 The integrators (render/integrators.py) call force(); the canvas reads only points() and the Python-side
 contract (LINKS, bob_sizes(), reach(), lengths).
@@ -14,6 +14,7 @@ import numpy as np
 import taichi as ti
 
 from . import budget, grid, integrators, keys, runtime
+from .sincos import sincos
 from .errors import SimulationError
 
 DEFAULT_MAX_DRIFT = 0.05
@@ -37,7 +38,8 @@ class System(runtime.Launcher):
     ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
     ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
     ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
-    LANES = 1  # pendulums per loop iteration of the advance kernel
+    LANES = 1  # pendulums per lane matrix (the columns integrators.step sees)
+    CHUNK = 16  # pendulums per group of the advance kernel in f64; f32 takes twice as many (see advance)
 
     @classmethod
     def preset_keys(cls) -> dict:
@@ -51,6 +53,7 @@ class System(runtime.Launcher):
         p = scene.pendulums
         self.count = p.count
         self.method = scene.integrator.method
+        self.libm = scene.integrator.trig == "libm"
         self.damped = scene.has("damping")
         self.damping = p.damping
         self.g = p.gravity
@@ -64,8 +67,9 @@ class System(runtime.Launcher):
         if not allocate:
             return
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
-        self.groups = -(-self.n // self.LANES)
         real = runtime.real()
+        self.chunk = self.CHUNK * (2 if real == ti.f32 else 1)  # 4 vector registers of lanes either way
+        self.groups = -(-self.n // self.chunk)
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
         self.bad = runtime.field("watchdog.bad", ti.i32, ())
@@ -98,7 +102,7 @@ class System(runtime.Launcher):
 
     def advance_by(self, substeps: int, h: float | None = None):
         """`substeps` steps of h (default: the scene's step)."""
-        self.advance(substeps, self.h if h is None else h)
+        (self.advance_libm if self.libm else self.advance)(substeps, self.h if h is None else h)
 
     # --------------------------------------------------------------- per-system parts (Python)
     def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
@@ -173,6 +177,14 @@ class System(runtime.Launcher):
 
     # --------------------------------------------------------------- shared Taichi parts
     @ti.func
+    def sincos(self, x):
+        """(sin x, cos x) for accel: inline (render/sincos.py) unless the scene asks for libm's exact bits."""
+        if ti.static(self.libm):
+            return ti.sin(x), ti.cos(x)
+        else:
+            return sincos(x)
+
+    @ti.func
     def lane_force(self, q, v):
         a = self.accel(q, v)
         if ti.static(self.damped):
@@ -187,32 +199,46 @@ class System(runtime.Launcher):
         else:
             return self.lane_force(q, v)
 
-    @ti.func
-    def gather(self, g: ti.i32):
-        """Group g's pendulums as lane matrices; the last group repeats its last pendulum as padding."""
-        q = ti.Matrix.cols([self.q[ti.min(g * self.LANES + lane, self.n - 1)]
-                            for lane in ti.static(range(self.LANES))])
-        v = ti.Matrix.cols([self.v[ti.min(g * self.LANES + lane, self.n - 1)]
-                            for lane in ti.static(range(self.LANES))])
-        return q, v
-
-    @ti.func
-    def scatter(self, g: ti.i32, q, v):
-        for lane in ti.static(range(self.LANES)):
-            i = g * self.LANES + lane
-            if i < self.n:
-                self.q[i], self.v[i] = q[:, lane], v[:, lane]
-                if not (ti.abs(q[:, lane]).max() < 1e30 and ti.abs(v[:, lane]).max() < 1e30):  # also NaN
-                    ti.atomic_min(self.bad[None], i)
-
     @ti.kernel
     def advance(self, substeps: ti.i32, h: float):
-        """All pendulums `substeps` steps of h on: the state stays in registers for the whole frame."""
+        """All pendulums `substeps` steps of h on, in groups of `chunk`: the state stays in registers and on the
+        stack for the whole frame, and is read and written once.
+
+        Each group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
+        stack array rather than chunk·D scalars), and each substep is a loop over those columns that steps one
+        pendulum (a D × 1 lane matrix) at a time. With no call and no branch on values in the step, LLVM's
+        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction: that loop is the SIMD. Every
+        pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
+        at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
+        B = ti.static(self.chunk)
         for g in range(self.groups):
-            q, v = self.gather(g)
+            Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
+            for lane in range(B):
+                i = ti.min(g * B + lane, self.n - 1)
+                Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+            for _ in range(substeps):
+                for lane in range(B):  # the loop LLVM vectorises
+                    q, v = integrators.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                    Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+            for lane in range(B):
+                i = g * B + lane
+                if i < self.n:
+                    self.q[i], self.v[i] = Q[:, lane], V[:, lane]
+                    if not (ti.abs(Q[:, lane]).max() < 1e30 and ti.abs(V[:, lane]).max() < 1e30):  # also NaN
+                        ti.atomic_min(self.bad[None], i)
+
+    @ti.kernel
+    def advance_libm(self, substeps: ti.i32, h: float):
+        """advance for scenes that pin libm's sin/cos: one pendulum per iteration, as before the chunks (libm
+        calls do not vectorise), so its results are the earlier releases' to the bit (LLVM merges sin and cos
+        differently in the chunked loop, and in f32 from upright those bits decide the chaos)."""
+        for i in range(self.n):
+            q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
             for _ in range(substeps):
                 q, v = integrators.step(self, q, v, h)
-            self.scatter(g, q, v)
+            self.q[i], self.v[i] = q[:, 0], v[:, 0]
+            if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
+                ti.atomic_min(self.bad[None], i)
 
     @ti.kernel
     def energies(self, first: ti.i32):

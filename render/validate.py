@@ -22,6 +22,7 @@ from .vary import PANEL_MIN, VARIANTS, VARYING, dotted, frozen, plain, vary_refu
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
+TRIGS = ("inline", "libm")  # integrator.trig: render/sincos.py, or the C library's (bit for bit as the seed)
 FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
 LAYOUTS = ("fan", "grid")
 FRACTALS = ("angles", "flip_time", "divergence")  # how a map (effects = ["fractal"]) colours its pixels
@@ -258,6 +259,7 @@ class Validator:
                 self.fail("integrator.dt", f"must be a number of seconds or \"auto\", got {clip(repr(dt))}")
             dt = self.real(d, "integrator", "dt", 0.0, 1.0, lo_open=True)
         prec = self.choice(d["integrator"]["precision"], "integrator.precision", PRECISIONS)
+        trig = self.choice(d["integrator"]["trig"], "integrator.trig", TRIGS)
         allow = d["integrator"]["allow_unstable"]
         if not isinstance(allow, bool):
             self.fail("integrator.allow_unstable", f"must be true or false, got {tname(allow)}")
@@ -266,8 +268,8 @@ class Validator:
             drift = self.real(d, "integrator", "max_drift", 0.0, 1e6, lo_open=True)
         tol = self.real(d, "integrator", "tolerance", 0.0, 1.0, lo_open=True)
         least = self.real(d, "integrator", "min_faithful", 0.0, 1.0)
-        return {"method": method, "dt": dt, "precision": prec, "allow_unstable": allow, "max_drift": drift,
-                "tolerance": tol, "min_faithful": least}
+        return {"method": method, "dt": dt, "precision": prec, "trig": trig, "allow_unstable": allow,
+                "max_drift": drift, "tolerance": tol, "min_faithful": least}
 
     def effects(self, d, system, pend, fractal) -> tuple[str, ...]:
         given = d["effects"]

@@ -36,11 +36,12 @@ class Rigid(System):
 
     @ti.func
     def accel(self, q, v):
-        # Only sin/cos of θ1 and θ2 are evaluated: the rest follow by angle addition. Scalar libm trig is 93 %
-        # of the kernel's time on a CPU (benchmarks/README.md), so 4 calls instead of 6 is a 1.5x speed-up.
+        # Only sin/cos of θ1 and θ2 are evaluated, inline (render/sincos.py: no libm call, so the advance loop
+        # vectorises) unless the scene pins libm; the rest follow by angle addition.
         m1, m2, l1, l2, g = self.m1, self.m2, self.l1, self.l2, self.g
         w1, w2 = v[0, :], v[1, :]
-        s1, c1, s2, c2 = ti.sin(q[0, :]), ti.cos(q[0, :]), ti.sin(q[1, :]), ti.cos(q[1, :])
+        s1, c1 = self.sincos(q[0, :])
+        s2, c2 = self.sincos(q[1, :])
         sd, cd = s1 * c2 - c1 * s2, c1 * c2 + s1 * s2  # sin, cos of θ1 − θ2
         den = 2.0 * (m1 + m2 * sd * sd)  # 2m1 + m2 − m2·cos 2(θ1 − θ2), without the cancellation
         a1 = (-g * (2.0 * m1 + m2) * s1 - m2 * g * (sd * c2 - cd * s2)  # sin(θ1 − 2θ2) = sin(Δ − θ2)
