@@ -13,6 +13,8 @@ import pytest
 from conftest import PICKS, render_small
 from render.scene import list_presets
 
+pytestmark = pytest.mark.xdist_group("preset_renders")  # one worker renders the presets for both
+
 GOLDEN = Path(__file__).parent / "golden"
 DIFFS = Path(__file__).resolve().parent.parent / "out" / "golden-diffs"
 ATOL = 2

@@ -189,6 +189,7 @@ def test_watchdog_names_energy_drift(tmp_path):
 def test_interrupted_render_leaves_no_files(tmp_path, sig, code):
     proc = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
                              "--no-progress", "--set", "video.width=320", "--set", "video.height=180",
+                             "--set", "video.duration=120",  # long enough to be mid-render whatever the machine
                              "--name", "interrupted"], cwd=ROOT, stderr=subprocess.PIPE, text=True)
     target = tmp_path / "interrupted"
     deadline = time.time() + 120
