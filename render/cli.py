@@ -124,6 +124,10 @@ def main(argv=None) -> int:
         raise Terminated()
 
     signal.signal(signal.SIGTERM, on_term)
+    # A process started in the background by a non-interactive shell inherits SIGINT ignored, and Python then
+    # installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. Ctrl-C or
+    # `kill -INT` always interrupts a render here (and cleans up, below).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     # read before parsing, so that even an error while parsing can show its traceback
     debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")

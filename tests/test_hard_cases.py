@@ -189,8 +189,10 @@ def test_watchdog_names_energy_drift(tmp_path):
 def test_interrupted_render_leaves_no_files(tmp_path, sig, code):
     proc = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
                              "--no-progress", "--set", "video.width=320", "--set", "video.height=180",
-                             "--set", "video.duration=120",  # long enough to be mid-render whatever the machine
-                             "--name", "interrupted"], cwd=ROOT, stderr=subprocess.PIPE, text=True)
+                             "--name", "interrupted"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                            # started as a non-interactive shell starts a background job: SIGINT ignored, which
+                            # the render must undo (it exited 0, rendered to the end, before cli.main did)
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     target = tmp_path / "interrupted"
     deadline = time.time() + 120
     while not list(target.glob(".*.part")) and time.time() < deadline:  # encoding has begun
