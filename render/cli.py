@@ -15,7 +15,7 @@ from pathlib import Path
 
 from . import accuracy, batch, bench, comparison, gallery, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, add_name, add_quality, output_name, progress_wanted, thread_count
+from .options import add_common, add_quality, add_render_options, output_name, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
 MODULES = (accuracy, batch, bench, comparison, gallery, show)
@@ -45,12 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "with a [compare] table renders its split-screen comparison into "
                                    "OUT/compare/NAME/ (see `pendulum compare`).")
     r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
-    add_common(r)
-    r.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
-    add_name(r)
-    add_quality(r)
-    r.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
-    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_render_options(r)
     r.set_defaults(func=cmd_render)
 
     s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",

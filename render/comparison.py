@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import batch, pipeline
 from .errors import SceneError
-from .options import add_common, add_name, add_quality, check_writable, output_name, progress_wanted, thread_count
+from .options import add_render_options, check_writable, output_name, progress_wanted
 from .scene import from_dict, load, parse_override
 from .vary import VARIANTS, VARYING, vary_refusal
 
@@ -47,12 +47,7 @@ def add_parser(sub):
                         "integrator.dt, integrator.precision, quality, or under [pendulums] (lengths, masses, "
                         "gravity, damping, stiffness); repeat to vary keys together, paired value by value "
                         "(default: the preset's own [compare] table)")
-    add_common(c)
-    c.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
-    add_name(c)
-    add_quality(c)
-    c.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
-    c.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_render_options(c)
     c.set_defaults(func=run)
 
 

@@ -24,6 +24,17 @@ def add_common(p):
                    help="Taichi backend; cuda falls back to the CPU with a warning where there is none")
 
 
+def add_render_options(p):
+    """What `render` and `compare` share after the preset: --set/--arch, --out, --name, --quality, --threads
+    and --no-progress."""
+    add_common(p)
+    p.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    add_name(p)
+    add_quality(p)
+    p.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
 def add_quality(p):
     p.add_argument("--quality", choices=LEVELS,
                    help="a guarantee instead of the preset's integrator: the median pendulum stays faithful for "
