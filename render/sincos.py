@@ -8,28 +8,28 @@ and those calls were 93 % of the rigid kernel's time. These are plain arithmetic
 Method: j = round(x·2/π), r = x − j·π/2 with π/2 split Cody-Waite style (P1 has 33 significant bits, so
 j·P1 is exact for |j| < 2^20, |x| < 1.6e6), then sin and cos of r ∈ [−π/4, π/4] by fdlibm's minimax
 polynomials (__kernel_sin / __kernel_cos, degree 13 / 14) in f64, Cephes' sinf / cosf (degree 7 / 8) in
-f32 (their tails in f32, the leading terms in f64); the quadrant j mod 4 swaps and negates with ti.select. `sincos` picks the form at compile time from
-the runtime's settings:
-  f64, fast_math (the project's setting)  -> sincos_f64: a reassociation-proof 2- or 3-part reduction;
-  f64 without fast_math                   -> sincos_f64_precise: fdlibm's double-double reduction;
-  f32                                      -> sincos_f32: the reduction and the leading terms in f64.
+f32 (their tails in f32, the leading terms in f64); the quadrant j mod 4 swaps and negates with ti.select.
+`sincos` picks the form at compile time from the runtime's float type:
+  f64 -> sincos_f64: fdlibm's double-double reduction (π/2 to 119 bits) and kernels that take its tail;
+  f32 -> sincos_f32: the reduction and the leading terms in f64.
 
-fast_math gives every float op LLVM's `reassoc nsz` flags, and LLVM then rewrites x − j·P1 − j·P2 as
-x − j·(P1 + P2): the split is folded away and the result is off by up to 1e-5 rad at |x| = 1e5. So the
-later parts are multiplied by copies of j re-made from the integer quadrant (float(k), float(−k)), which
-LLVM does not prove equal to ±j. A reduction in f32 alone (π/2 in 8 + 8 + 24 bits) was 30 % faster in the
-f32 kernel but up to 1e7 ulp wrong (478 ulp already at |x| <= 512): not used. Cephes' polynomials wholly in
-f32 (after the f64 reduction) give 1.57 ulp and the rigid f32 kernel 50M steps/s instead of 36M, but an f32
-flip map then parted from DOP853 where its trust mask vouched for it (tests/test_fractal.py): the f32 form
-here is as close to libm's sinf (0.56 ulp) as the f64 leading terms make it.
+Both need IEEE arithmetic: Taichi's fast_math gives every float op LLVM's `reassoc nsz` flags, and LLVM may
+then fold the compensation terms away (x − j·P1 − j·P2 becomes x − j·(P1 + P2)). Whether it does depends on
+the CPU it compiles for: a fast_math-proof variant (the later parts multiplied by copies of j re-made from
+the integer quadrant) held on AVX2 but was 2.3e8 ulp off near k·π/2 on AVX-512, where the code generator
+proved the copies equal to j. So runtime.init starts Taichi with fast_math=False, and `sincos` refuses to
+compile under fast_math. (Measured on rigid RK4 at N = 1e5: fast_math off costs no measurable speed, since
+the advance loop still vectorises; `pendulum bench` reports the steps/s.) A reduction in f32 alone (π/2 in
+8 + 8 + 24 bits) was 30 % faster in the f32 kernel but up to 1e7 ulp wrong: not used. Cephes' polynomials
+wholly in f32 give 1.57 ulp, but an f32 flip map then parted from DOP853 where its trust mask vouched for it
+(tests/test_fractal.py): the f32 form here is as close to libm's sinf as the f64 leading terms make it.
 
-Measured error (ulp of the exact result; f64 against mpmath at 150 bits, f32 against libm's f64 result):
-  sincos_f64 (fast_math on or off): 1.56 ulp on |x| <= 1e5, 0.60 ulp on the doubles nearest k·π/2;
-  sincos_f64_precise (fast_math off): 0.77 ulp; (with fast_math on it is wrong: `sincos` never uses it so);
-  sincos_f32: 0.76 ulp (measured on 1.6e5 floats to |x| <= 1e5 and near k·π/2).
-tests/test_sincos.py holds f64 to 2 ulp and f32 to 1 ulp of the exact value. Beyond |x| = 1.6e6 the reduction degrades slowly;
-|x| > 1e9 (where the i32 quadrant would overflow), NaN and ±inf give NaN. Subnormal inputs are flushed to
-0 by Taichi's CPU runtime, so sin(1e-310) = 0.
+Measured error (ulp of the exact result; f64 and f32 against numpy's long double), tests/test_sincos.py, in
+the scalar, the lane and the chunked-loop forms alike: sincos_f64 0.76 ulp, sincos_f32 0.76 ulp, on 3.6e5
+arguments (uniform to |x| <= 1e5, log-spread from 1e-8, and the floats nearest k·π/2). The test holds f64
+to 1 ulp and f32 to 1 ulp. Beyond |x| = 1.6e6 the reduction degrades slowly; |x| > 1e9 (where the i32
+quadrant would overflow), NaN and ±inf give NaN. Subnormal inputs are flushed to 0 by Taichi's CPU runtime,
+so sin(1e-310) = 0.
 """
 import math
 
@@ -54,7 +54,6 @@ FS1, FS2, FS3 = -1.6666654611e-1, 8.3321608736e-3, -1.9515295891e-4
 FC1, FC2, FC3 = 4.166664568298827e-2, -1.388731625493765e-3, 2.443315711809948e-5
 
 XMAX = 1.0e9  # |x| beyond this gives NaN: the i32 quadrant would overflow near 3.4e9 into finite garbage
-DEEP = 2.44140625e-4  # 2^-12: below it the two-part r has lost too many bits to cancellation
 
 
 @ti.func
@@ -83,26 +82,7 @@ def _poly_f64(r):
 
 @ti.func
 def sincos_f64(x):
-    """f64, safe under fast_math. r = (x − j·P1) + j''·P1T (π/2 to 86 bits); where that leaves |r| < 2^-12
-    (deep cancellation near a multiple of π/2) r = ((x − j·P1) − j'·P2) + j''·P2T (119 bits) instead.
-    j' = float(k), j'' = float(−k) with k = int(j): LLVM does not prove them ±j, so it cannot merge the parts.
-    (With j' in the two-part r, LLVM did prove it on ti.Vector lanes: 3e9 ulp. tests/test_sincos.py checks
-    the scalar, the lane and the chunked-loop forms.)"""
-    j = ti.round(x * TWO_OVER_PI)
-    k = ti.cast(j, ti.i32)
-    nk = ti.cast(-k, ti.f64)
-    r0 = x - j * P1  # exact
-    ra = r0 + nk * P1T
-    rb = (r0 - ti.cast(k, ti.f64) * P2) + nk * P2T
-    s, c = _poly_f64(ti.select(ti.abs(ra) < DEEP, rb, ra))
-    sn, cs = _quadrant(k, s, c)
-    return _guard(x, sn, cs)
-
-
-@ti.func
-def sincos_f64_precise(x):
-    """f64, fdlibm's way (< 1 ulp): a double-double r + rr (π/2 to 119 bits) and kernels that take the tail.
-    Needs fast_math off: reassociation folds the compensation terms away."""
+    """f64, fdlibm's way (< 1 ulp): a double-double r + rr (π/2 to 119 bits) and kernels that take the tail."""
     j = ti.round(x * TWO_OVER_PI)
     r0 = x - j * P1  # exact
     w = j * P2  # exact
@@ -148,9 +128,9 @@ def _cfg():
 @ti.func
 def sincos(x):
     """(sin x, cos x), elementwise, in the runtime's float type. Branchless, no libm."""
-    if ti.static(_cfg().default_fp == ti.f64 and not _cfg().fast_math):
-        return sincos_f64_precise(x)
-    elif ti.static(_cfg().default_fp == ti.f64):
+    if ti.static(_cfg().fast_math):
+        raise RuntimeError("render/sincos.py needs Taichi started with fast_math=False (runtime.init does)")
+    if ti.static(_cfg().default_fp == ti.f64):
         return sincos_f64(x)
     else:
         return sincos_f32(x)
