@@ -40,7 +40,7 @@ bench: $(BIN)/pendulum
 batch: $(BIN)/pendulum
 	$(BIN)/pendulum batch
 
-# Measure, then put the figures into README.md (generated blocks) and benchmarks/figures/. Run on a quiet machine.
+# Measure, then put the figures into README.md and docs/*.md (generated blocks) and benchmarks/figures/. Run on a quiet machine.
 figures: $(BIN)/pendulum
 	$(BIN)/pendulum accuracy
 	$(BIN)/pendulum render benchmarks/fractal_flip_readme.toml --no-progress

@@ -1,15 +1,17 @@
-"""Put measured figures into README.md: generated tables between markers, generated images in benchmarks/figures/.
+"""Put measured figures into the docs: generated tables between markers, generated images in benchmarks/figures/.
 
     .venv/bin/python benchmarks/readme_figures.py [--out out]
 
-`make figures` runs the commands that measure them first (see the Makefile). A README block
+`make figures` runs the commands that measure them first (see the Makefile). A block, in README.md or any
+page docs/*.md,
 
     <!-- generated: accuracy/quality.md -->
     ...
     <!-- end generated -->
 
-is replaced by the file out/accuracy/quality.md as the last run wrote it, so no figure in the README is copied
-by hand. Images listed in IMAGES are copied from out/ into benchmarks/figures/, which the README links.
+is replaced by the file out/accuracy/quality.md as the last run wrote it, so no figure in the docs is copied
+by hand, and a block moved to another page is still filled there. Images listed in IMAGES are copied from
+out/ into benchmarks/figures/, which the pages link by relative paths (../benchmarks/figures/ from docs/).
 """
 import argparse
 import re
@@ -18,7 +20,6 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-FIGURES = ROOT / "benchmarks" / "figures"
 IMAGES = {  # out/<source> -> benchmarks/figures/<name>
     "accuracy/work_precision_rigid_chaos.png": "work_precision_rigid_chaos.png",
     "accuracy/faithful_rigid_chaos.png": "faithful_rigid_chaos.png",
@@ -30,25 +31,45 @@ IMAGES = {  # out/<source> -> benchmarks/figures/<name>
 BLOCK = re.compile(r"(<!-- generated: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.S)
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=ROOT / "out", help="where the commands wrote (default: out)")
-    args = ap.parse_args()
-    readme = (ROOT / "README.md").read_text()
-    missing = []
+def pages(root: Path = ROOT) -> list[Path]:
+    """The pages that may hold generated blocks: README.md and docs/*.md."""
+    return [root / "README.md", *sorted((root / "docs").glob("*.md"))]
+
+
+def splice(text: str, out: Path) -> tuple[str, list[str], list[str]]:
+    """(text with each block's body replaced by out/<src>, the sources filled, the sources not found).
+    A block whose source is missing keeps its old body."""
+    filled, missing = [], []
 
     def fill(m):
-        src = args.out / m["src"]
+        src = out / m["src"]
         if not src.is_file():
             missing.append(str(src))
             return m.group(0)
+        filled.append(m["src"])
         return m.group(1) + src.read_text().rstrip() + "\n" + m.group(4)
 
-    (ROOT / "README.md").write_text(BLOCK.sub(fill, readme))
-    FIGURES.mkdir(parents=True, exist_ok=True)
+    return BLOCK.sub(fill, text), filled, missing
+
+
+def main(argv=None, root: Path = ROOT) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=root / "out", help="where the commands wrote (default: out)")
+    args = ap.parse_args(argv)
+    missing = []
+    for page in pages(root):
+        text = page.read_text()
+        new, filled, lost = splice(text, args.out)
+        missing += lost
+        if new != text:
+            page.write_text(new)
+        for src in filled:
+            print(f"{page.relative_to(root)}: {src}")
+    figures = root / "benchmarks" / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
     for src, name in IMAGES.items():
         if (args.out / src).is_file():
-            shutil.copyfile(args.out / src, FIGURES / name)
+            shutil.copyfile(args.out / src, figures / name)
         else:
             missing.append(str(args.out / src))
     if missing:
