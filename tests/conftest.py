@@ -12,6 +12,25 @@ os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
 ROOT = Path(__file__).resolve().parent.parent
 
 
+# CI installs every tool the tests use (.ci/run), so a skip there is a test that did not run: only the
+# bench-only numba peer may skip. Elsewhere a skip is a missing tool, listed with its reason by `-ra`.
+CI_MAY_SKIP = ("numba",)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    if hasattr(session.config, "workerinput") or os.environ.get("CI") != "true":
+        return  # an xdist worker (the controller holds every report), or not CI
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    skipped = reporter.stats.get("skipped", []) if reporter else []
+    reasons = [str(r.longrepr[2] if isinstance(r.longrepr, tuple) else r.longrepr) for r in skipped]
+    banned = [f"{r.nodeid}: {why}" for r, why in zip(skipped, reasons) if not any(k in why for k in CI_MAY_SKIP)]
+    if banned and reporter:
+        reporter.write_line(f"CI: {len(banned)} test(s) skipped that CI must run:", red=True)
+        for line in banned:
+            reporter.write_line(f"  {line}")
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
 def pytest_addoption(parser):
     parser.addoption("--update-goldens", action="store_true",
                      help="rewrite tests/golden/<preset>/*.png from the current renderer instead of comparing")

@@ -215,6 +215,7 @@ def cases(draw):
     return text, sets, command, options
 
 
+@pytest.mark.xdist_group("fuzz")  # with the check below on one worker: it reads what this one counted
 @settings(max_examples=600, deadline=None, derandomize=True, database=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(cases())
@@ -233,6 +234,7 @@ def test_fuzzed_presets_sets_and_options_exit_0_or_2_with_one_line(case):
         assert_contract(code, err, out.exists() and list(out.rglob("*")), argv)
 
 
+@pytest.mark.xdist_group("fuzz")
 def test_the_fuzz_reaches_valid_and_invalid_scenes():
     """The case mix above is not degenerate: a good share of cases pass every check (and a good share not)."""
     if not OUTCOMES:
