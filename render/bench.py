@@ -219,7 +219,7 @@ def phase_encode(cfg, arch, tmp) -> dict:
     frames = np.memmap(raw, np.uint8, "r", shape=(scene.frames, v.height, v.width, 3))
     (tmp / "floor").mkdir(exist_ok=True)
     t = time.perf_counter()
-    enc = Encoder(tmp / "floor", scene.name, v)
+    enc = Encoder(tmp / "floor", scene.name, v, scene.frames)
     for f in range(scene.frames):
         enc.write(frames[f])
     enc.close()

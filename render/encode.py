@@ -10,12 +10,14 @@ them). The pipes are enlarged so a writer hands over a frame in a few system cal
 """
 from __future__ import annotations
 
+import math
 import os
 import queue
 import subprocess
 import tempfile
 import threading
 import time
+from fractions import Fraction
 from pathlib import Path
 
 import imageio_ffmpeg
@@ -53,13 +55,31 @@ def mp4_args(video) -> list[str]:
 
 
 def gif_args(video) -> list[str]:
-    fps = min(video.gif_fps, video.fps)
     width = min(video.gif_width, video.width)  # downscale only: a small video keeps its own size
-    # eof_action=pass: the last input frame always counts, so a one-frame video still makes a GIF
-    graph = (f"fps={fps}:eof_action=pass,scale={width}:-2:flags=area,split[a][b];"
+    graph = (f"scale={width}:-2:flags=area,split[a][b];"
              f"[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
              f"[b][p]paletteuse=dither=bayer:bayer_scale=3")
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
+
+
+def gif_rate(video) -> int:
+    return min(video.gif_fps, video.fps)
+
+
+def _near(x: Fraction) -> int:
+    return math.floor(x + Fraction(1, 2))  # ffmpeg's AV_ROUND_NEAR_INF, for x >= 0
+
+
+def gif_repeats(video, frames: int) -> list[int]:
+    """How many GIF frames each video frame becomes (mostly 0 or 1): the GIF's frames are picked here and only
+    those are piped, instead of every frame for ffmpeg's fps filter to drop (2/3 of the pipe at 60 -> 20 fps).
+    The picks are that filter's (eof_action=pass): GIF frame k shows the last video frame whose time, rounded
+    to the GIF's clock, is at most k, for k < ceil(frames·gif/fps); so the GIF is byte-identical to the one the
+    filter made (checked against ffmpeg for 585 rate and length pairs: tests/test_render.py)."""
+    r = Fraction(gif_rate(video), video.fps)
+    slots = math.ceil(frames * r)
+    starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
+    return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
 
 
 ARGS = {"mp4": mp4_args, "gif": gif_args}
@@ -79,8 +99,9 @@ class _Still:
 class _Target:
     """One ffmpeg process, the thread that feeds it, and where its output goes."""
 
-    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log):
+    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None):
         self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
+        self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
         self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
@@ -112,8 +133,9 @@ class _Target:
 class Encoder:
     """Writes `frames` to out_dir/NAME.<fmt> for each format; use as a context manager or call close/abort."""
 
-    def __init__(self, out_dir: Path, name: str, video, formats=None):
+    def __init__(self, out_dir: Path, name: str, video, frames: int, formats=None):
         self.targets: list[_Target] = []
+        self.written = 0
         self.stills: list[_Still] = []
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         try:
@@ -124,8 +146,9 @@ class Encoder:
                     continue
                 tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
+                rate = gif_rate(video) if fmt == "gif" else video.fps
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
-                       "-s", f"{video.width}x{video.height}", "-r", str(video.fps), "-i", "-", "-an",
+                       "-s", f"{video.width}x{video.height}", "-r", str(rate), "-i", "-", "-an",
                        *ARGS[fmt](video), tmp]
                 try:
                     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
@@ -134,7 +157,8 @@ class Encoder:
                     tmp.unlink(missing_ok=True)
                     log.close()
                     raise
-                self.targets.append(_Target(final, tmp, proc, log))
+                self.targets.append(_Target(final, tmp, proc, log,
+                                            gif_repeats(video, frames) if fmt == "gif" else None))
         except BaseException:
             self.abort()
             raise
@@ -162,7 +186,9 @@ class Encoder:
             if t.error is not None:
                 raise EncodeError(f"ffmpeg stopped: {self._logs() or t.error}")
         for t in self.targets:
-            t.queue.put(frame)
+            for _ in range(1 if t.repeats is None else t.repeats[self.written]):
+                t.queue.put(frame)
+        self.written += 1
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept
 

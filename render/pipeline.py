@@ -154,7 +154,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     scene, timings = src.scene, src.timings
     timings["encode"] = 0.0
     with output_dir(scene.out_dir(out_root)) as out_dir:
-        enc = Encoder(out_dir, scene.name, scene.video)
+        enc = Encoder(out_dir, scene.name, scene.video, scene.frames)
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
                 for f in range(scene.frames):
