@@ -75,7 +75,7 @@ def read_json(path: Path):
         if not stat.S_ISREG(st.st_mode):
             raise Refused(f"{path.name} is {_kind(st.st_mode)}, not a regular file")
         if st.st_size > META_MAX_BYTES:
-            raise Refused(f"{path.name} is {st.st_size} bytes, over the {META_MAX_BYTES} read")
+            raise Refused(f"{path.name} is {st.st_size} bytes, over the {META_MAX_BYTES}-byte limit")
         chunks, size = [], 0  # read to the end, one byte past the cap at most: it may have grown since fstat
         while size <= META_MAX_BYTES and (chunk := os.read(fd, META_MAX_BYTES + 1 - size)):
             chunks.append(chunk)
@@ -83,7 +83,7 @@ def read_json(path: Path):
     finally:
         os.close(fd)
     if size > META_MAX_BYTES:
-        raise Refused(f"{path.name} is over the {META_MAX_BYTES} bytes read")
+        raise Refused(f"{path.name} is over the {META_MAX_BYTES}-byte limit")
     try:
         return json.loads(b"".join(chunks), parse_int=_int)
     except RecursionError:
