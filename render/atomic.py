@@ -4,7 +4,8 @@ A temporary file is hidden and names its owner: .NAME.<host>-<pid>.<random>.part
 hash of the host name. A process killed with SIGKILL cannot remove its temporaries, so whoever next writes
 into that folder sweeps the ones whose owner is gone (sweep_stale): on this host, a process that no longer
 exists; from another host sharing the folder (a Dask cluster), where liveness cannot be seen from here,
-only after FOREIGN_STALE_S without a write. A live writer's file is never touched.
+only after FOREIGN_STALE_S without a write. A live writer's file is never touched, and neither is a folder
+reached through a symlink at its end: that may lead out of the output folder, to files not ours to judge.
 """
 import hashlib
 import os
@@ -35,7 +36,10 @@ def sweep_stale(folder: Path) -> list[Path]:
     """Remove the temporaries in `folder` whose writer is gone; returns what was removed."""
     removed = []
     try:
-        entries = list(os.scandir(folder))
+        if os.path.islink(folder):
+            return removed
+        with os.scandir(folder) as it:
+            entries = list(it)
     except OSError:
         return removed  # a folder not there yet holds nothing to sweep
     for entry in entries:
