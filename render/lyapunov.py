@@ -21,9 +21,12 @@ what the running average moved over the last half, |λ(T) − λ(T/2)| (for a bi
 reported is Z = 2 standard errors plus that drift. The pairs' errors are computed the same way from the
 summed rates (their fluctuations are correlated: adding the exponents' errors would overstate them).
 
-Cost (classic, 1 pendulum, rk4 dt 1e-3, measured on the shared 2-core machine, so indicative): the tangent
-kernel's four dual passes and the host's per-frame QR make one simulated second about 25 ms of wall time;
-the forward-mode kernel compiles in about 2 s.
+Cost, measured on the shared 2-core machine at a load of about 8 (indicative only): per frame of classic (1
+pendulum, 17 RK4 substeps) the tangent map took 3 to 5 ms, of which about 1 ms is its kernel and the rest the
+Taichi launches that move seeds and images (about 0.5 ms each there), the primal frame about 1 ms, numpy's
+QR 0.2 ms: launch-bound, so 8 pendulums cost little more than 1, and fewer frames (a lower video.fps, with
+the same dt) cost less at the same result (the R product does not depend on how often QR runs, up to
+round-off). The forward-mode kernel compiles in about 2 s (rigid) to 5 s (triple).
 """
 from __future__ import annotations
 
