@@ -49,6 +49,16 @@ def test_damped_sum_is_minus_d_times_c_at_every_duration():
         assert row["exponents"] == sorted(row["exponents"], reverse=True)
 
 
+def test_the_spectrum_is_the_same_at_one_and_two_threads():
+    """Every tangent vector is its own kernel element (no reduction), the primal is thread-invariant, and QR
+    runs in numpy: the running estimates agree to the bit."""
+    scene = load("damped_heavy", ["video.duration=1"])
+    indices = lyapunov.default_pendulums(scene)
+    one = lyapunov.spectrum(scene, indices, threads=1)["running"]
+    two = lyapunov.spectrum(scene, indices, threads=2)["running"]
+    assert np.array_equal(one, two)
+
+
 def test_pairs_vanish_within_the_reported_error_and_the_error_is_honest(classic_200s):
     """Over 200 s the pairs λ1 + λ4 and λ2 + λ3 are within the error the command reports. Honest both ways:
     the errors reported at 100 s (from the run's first half only) cover where each exponent went by 200 s,
