@@ -143,7 +143,7 @@ def summary(run: dict, damping: float) -> list[dict]:
                     "checks": {"sum": float(lam.sum()), "expected_sum": 0.0 - D * damping,
                                "sum_defect": float(lam.sum() + D * damping),
                                "pair_sums": pairs.mean(0).tolist(), "pair_errors": error(pairs).tolist()},
-                    "order": order.tolist()})
+                    "columns": order.tolist()})  # the Benettin columns, as sorted
     return out
 
 
