@@ -112,3 +112,21 @@ def flagship_charts(out: Path, rows, name: str, horizon: float, duration: float,
     ax.set_ylim(0, duration * 1.02)
     save(fig, ax, out / f"faithful_{name}.png", COST, "median pendulum faithful until [s] (1e-3 rad of DOP853)",
          f"What accuracy buys: {name}, {duration:g} s, {count} pendulums; ring = dt 1e-3", ncol=2)
+
+
+def lyapunov_chart(path: Path, t: np.ndarray, running: np.ndarray, pendulums, name: str, expected_sum: float):
+    """The running estimates of the spectrum against time: running (F, n, 2D), one colour per exponent, one
+    line per pendulum; and their sum, which must sit on −D·c (dashed) at every time."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    dim = running.shape[2]
+    for k in range(dim):
+        for j, p in enumerate(pendulums):
+            ax.plot(t, running[:, j, k], color=f"C{k}", lw=1.0, alpha=1.0 if j == 0 else 0.45,
+                    label=f"λ{k + 1}" if j == 0 else None)
+    ax.plot(t, running[:, 0].sum(-1), color="black", lw=0.8, label="sum (first pendulum)")
+    ax.axhline(expected_sum, color="black", ls="--", lw=0.8, label=f"−D·c = {expected_sum + 0.0:g} 1/s")
+    ax.set_xscale("log")
+    which = ", ".join(map(str, pendulums[:8])) + (", ..." if len(pendulums) > 8 else "")
+    save(fig, ax, path, "simulated time t [s]", "running estimate (1/t)·Σ ln |R_ii| [1/s]",
+         f"Lyapunov spectrum, {name}: pendulum {which} (QR every frame)", ncol=2)

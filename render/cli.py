@@ -13,12 +13,12 @@ import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, comparison, gallery, show
+from . import accuracy, batch, bench, comparison, gallery, lyapunov_cli, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
 from .options import add_common, add_quality, add_render_options, output_name, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, comparison, gallery, show)
+MODULES = (accuracy, batch, bench, comparison, gallery, lyapunov_cli, show)
 
 
 class Terminated(BaseException):

@@ -1,0 +1,184 @@
+"""`pendulum lyapunov`: the spectrum's exact identities (the sum of the exponents is −D·c at every duration), its
+pairs and their reported error over a long run, λ1 against an independent reference (scipy DOP853 on
+variational equations written here, on render/reference.py's model), and the command's files and refusals."""
+import json
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from conftest import run_cli
+from render import certify, lyapunov, reference
+from render.scene import load
+
+
+@pytest.fixture(scope="module")
+def classic_200s():
+    """classic over 200 s (frames of 0.1 s: QR every frame, as often as the command does at this fps)."""
+    scene = load("classic", ["video.duration=200", "video.fps=10"])
+    run = lyapunov.spectrum(scene, np.array([0]))
+    return scene, run, lyapunov.summary(run, 0.0)[0]
+
+
+def test_undamped_sum_is_zero_at_every_duration(classic_200s):
+    """Volume is conserved in canonical (θ, p): the running sum stays within 1e-3·λ1 of 0 at every frame. What
+    is left is the RK4 numerical flow's own volume defect: far below that (measured: |ln det| of one frame's
+    tangent map ~1e-12, 1.7e-9 at the worst frame; the running sum within 5e-10 1/s of 0 at every frame)."""
+    _, run, row = classic_200s
+    lam1 = row["exponents"][0]
+    sums = run["running"][:, 0].sum(-1)
+    assert lam1 > 0.5  # classic is chaotic
+    assert np.abs(sums).max() < 1e-3 * lam1
+    assert np.abs(sums).max() < 1e-6 * lam1  # far below: the numerical flow is volume-preserving to ~1e-10
+    assert abs(row["checks"]["sum"]) < 1e-3 * lam1 and row["checks"]["expected_sum"] == 0.0
+
+
+def test_damped_sum_is_minus_d_times_c_at_every_duration():
+    """damped_heavy: c = 0.15 1/s on both coordinates, so the exponents sum to −0.30 1/s at any duration,
+    for every pendulum measured (the default ones: the certificate's, thinned)."""
+    scene = load("damped_heavy", ["video.duration=4"])
+    assert scene.pendulums.damping == 0.15
+    indices = lyapunov.default_pendulums(scene)
+    assert 2 <= len(indices) <= lyapunov.CAP and indices[0] == 0 and indices[-1] == scene.pendulums.count - 1
+    run = lyapunov.spectrum(scene, indices)
+    sums = run["running"].sum(-1)  # (frames, pendulums)
+    assert np.abs(sums + 0.30).max() < 1e-3 * 0.30, np.abs(sums + 0.30).max()
+    for row in lyapunov.summary(run, scene.pendulums.damping):
+        assert row["checks"]["expected_sum"] == pytest.approx(-0.30)
+        assert abs(row["checks"]["sum_defect"]) < 1e-3 * 0.30
+        assert row["exponents"] == sorted(row["exponents"], reverse=True)
+
+
+def test_the_spectrum_is_the_same_at_one_and_two_threads():
+    """Every tangent vector is its own kernel element (no reduction), the primal is thread-invariant, and QR
+    runs in numpy: the running estimates agree to the bit."""
+    scene = load("damped_heavy", ["video.duration=1"])
+    indices = lyapunov.default_pendulums(scene)
+    one = lyapunov.spectrum(scene, indices, threads=1)["running"]
+    two = lyapunov.spectrum(scene, indices, threads=2)["running"]
+    assert np.array_equal(one, two)
+
+
+def test_pairs_vanish_within_the_reported_error_and_the_error_is_honest(classic_200s):
+    """Over 200 s the pairs λ1 + λ4 and λ2 + λ3 are within the error the command reports. Honest both ways:
+    the errors reported at 100 s (from the run's first half only) cover where each exponent went by 200 s,
+    and they are not vacuous (λ1 known to a fraction of itself)."""
+    _, run, row = classic_200s
+    sums, errors = row["checks"]["pair_sums"], row["checks"]["pair_errors"]
+    assert len(sums) == 2
+    for s, e in zip(sums, errors):
+        assert abs(s) <= e, (sums, errors)
+        assert e < 0.05
+    half = run["rates"][:len(run["rates"]) // 2, 0]
+    lam_half, err_half = half.mean(0), lyapunov.error(half)
+    lam = run["rates"][:, 0].mean(0)
+    assert np.all(np.abs(lam - lam_half) <= err_half), (lam, lam_half, err_half)
+    assert row["errors"][0] < 0.3 * row["exponents"][0]
+
+
+def variational_lambda1(scene, i: int, t: np.ndarray) -> np.ndarray:
+    """λ1(t) of pendulum i from the canonical axis δq1, by DOP853 on the variational equations of
+    reference.py's model (its Jacobian by central differences of its force), the tangent vector carried
+    into (q, v) and back into canonical (q, p): p = M(θ)ω for a chain, m·v for springs."""
+    p = reference.params(scene)
+    q0, v0 = (a[i] for a in reference.initial_state(scene))
+    d, eps = len(q0), 1e-6
+
+    def accel(q, v):  # rows of states (N, d) -> (N, d)
+        return reference.accel(p, q, v)
+
+    def momenta(q, v):
+        if p.model == "chain":
+            return np.einsum("nij,nj->ni", reference.chain_mass(q, p), v)
+        return np.repeat(p.masses, 2) * v
+
+    steps = eps * np.eye(2 * d)
+
+    def jac(f, q, v):  # d f / d(q, v) at one state, (d, 2d), by central differences in one batched call
+        plus = f(q + steps[:, :d], v + steps[:, d:])
+        minus = f(q - steps[:, :d], v - steps[:, d:])
+        return ((plus - minus) / (2 * eps)).T
+
+    def rhs(_, y):
+        q, v, dq, dv = y[:d], y[d:2 * d], y[2 * d:3 * d], y[3 * d:]
+        return np.concatenate([v, accel(q[None], v[None])[0], dv, jac(accel, q, v) @ np.concatenate([dq, dv])])
+
+    jp = jac(momenta, q0, v0)  # δp = jp @ (δq, δv); solve for δv given δq = e1, δp = 0
+    dq0 = np.eye(d)[0]
+    dv0 = np.linalg.solve(jp[:, d:], -jp[:, :d] @ dq0)
+    sol = solve_ivp(rhs, (0, t[-1]), np.concatenate([q0, v0, dq0, dv0]), method="DOP853", t_eval=t,
+                    rtol=1e-11, atol=1e-11)
+    assert sol.success
+    out = []
+    for y in sol.y.T:
+        q, v, dq, dv = y[:d], y[d:2 * d], y[2 * d:3 * d], y[3 * d:]
+        out.append(np.log(np.linalg.norm(np.concatenate([dq, jac(momenta, q, v) @ np.concatenate([dq, dv])]))))
+    return np.array(out) / t
+
+
+CASES = {"classic": ("classic", [], 0), "triple_classic": ("triple_classic", ["video.duration=3"], 0),
+         "elastic_fan": ("elastic_fan", ["video.duration=2", "integrator.method=rk4"], 4)}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_lambda1_agrees_with_an_independent_variational_reference(case):
+    """Inside the certificate's faithful window, from the same initial tangent vector, λ1(t) of the package
+    (tangent map of its integrator, by forward-mode AD) matches DOP853 on independent variational equations
+    within 0.1 % (the brief asks 2 %) at every frame past the first second."""
+    preset, sets, i = CASES[case]
+    scene = load(preset, ["video.duration=5", *sets])
+    cert = certify.certify(scene.replace(integrator={"min_faithful": 0.0}), indices=np.array([i]))
+    assert cert.until_s[0] >= scene.video.duration  # the whole run is faithful
+    run = lyapunov.spectrum(scene, np.array([i]))
+    t = run["t"]
+    ours = run["running"][:, 0, 0]  # the first column: the growth of the first initial vector, δq1
+    ref = variational_lambda1(scene, i, t)
+    late = t >= 1.0
+    # The brief asks for 2 %; measured: 3e-9 (classic), 1.5e-8 (triple), 1.1e-5 (elastic_fan with rk4; with
+    # its preset's verlet at dt "auto" the numerical flow's own λ1 is 1.3 % off the exact flow's).
+    assert np.abs(ours[late] - ref[late]).max() <= 1e-3 * np.abs(ref[-1]), (ours[-1], ref[-1])
+    row = lyapunov.summary(run, 0.0)[0]  # the whole spectrum of every system: 2D exponents summing to 0
+    assert len(row["exponents"]) == {"rigid": 4, "triple": 6, "elastic": 8}[scene.system]
+    assert abs(row["checks"]["sum"]) < 1e-3 * row["exponents"][0]
+
+
+def test_the_command_writes_the_spectrum_and_its_chart(tmp_path):
+    r = run_cli("lyapunov", "damped_heavy", "--pendulums", "0,29", "--set", "video.duration=3", "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    (folder,) = tmp_path.iterdir()
+    assert folder.name.startswith("damped_heavy__")  # --set: not the preset's own folder
+    doc = json.loads((folder / "lyapunov.json").read_text())
+    assert [row["pendulum"] for row in doc["pendulums"]] == [0, 29] and doc["unit"] == "1/s"
+    for row in doc["pendulums"]:
+        assert len(row["exponents"]) == len(row["errors"]) == 4
+        assert row["exponents"] == sorted(row["exponents"], reverse=True)
+        assert row["duration_s"] == pytest.approx(3.0, abs=0.02)
+        assert row["checks"]["sum"] == pytest.approx(-0.30, abs=3e-4) and len(row["checks"]["pair_sums"]) == 2
+        f = row["faithfulness"]
+        assert f["faithful_until_s"] > 0 and f["tolerance"] == 1e-3 and f["initial_error"] > 0
+        if row["exponents"][0] > 0:
+            assert f["predicted_horizon_s"] > 0
+    png = (folder / "lyapunov.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    assert r.stdout.count("pendulum ") >= 2 and "lyapunov.json" in r.stdout
+
+
+@pytest.mark.parametrize("args, says", [
+    (["classic", "--pendulums", "1"], "--pendulums 1: no such pendulum"),
+    (["classic", "--pendulums", "0,x"], "must be pendulum indices"),
+    (["damped_heavy", "--pendulums", "3,3"], "a pendulum named twice"),
+    (["classic", "--set", "integrator.method=implicit_midpoint"], "integrator.method"),
+    (["classic", "--set", "video.duration=0.1"], "video.duration"),
+])
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, says):
+    r = run_cli("lyapunov", *args, "--out", tmp_path / "out")
+    assert r.returncode == 2 and says in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_help_explains_the_command():
+    r = run_cli("lyapunov", "--help")
+    assert r.returncode == 0
+    for word in ("Benettin", "lyapunov.json", "--pendulums", "canonical", "batch means"):
+        assert word in r.stdout
