@@ -76,7 +76,7 @@ def run(args) -> int:
     write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
     write_atomic(args.out / "report.md", markdown(report).encode())
     m = report["machine"]
-    write_atomic(args.out / "targets.md", "\n".join(  # for the README (benchmarks/readme_figures.py)
+    write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
         targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
                                  f"{m['cpus']} CPUs ({m['cpu']}), load average {m['load_avg'][0]:.2f} at the start, "
                                  f"numba {report['peers']['numba']}."]).encode() + b"\n")
@@ -333,7 +333,7 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
 
 
 def targets_table(r: dict) -> list[str]:
-    """The targets as a table: report.md's, and targets.md's, which the README's Performance section shows."""
+    """The targets as a table: report.md's, and targets.md's, which docs/performance.md shows."""
     return table(["target", "measured", "goal", "met", "measured / goal"],
                  [[k, fmt(g["value"]), g["goal"], "yes" if g["met"] else "not measured" if g["met"] is None
                    else "**no**", fmt(g["value_over_goal"], ".2f")] for k, g in r["targets"].items()])

@@ -32,7 +32,7 @@ class Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
-               epilog="Presets live in presets/*.toml; see README.md for the format.")
+               epilog="Presets live in presets/*.toml; see docs/presets.md for the format.")
     p.add_argument("--debug", action="store_true", help="on an error, print the traceback too "
                    "(or set PENDULUM_DEBUG=1)")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)

@@ -71,7 +71,7 @@ def quality_table(arch: str, quick: bool, step) -> list[dict]:
 
 
 def quality_md(rows: list[dict], quick: bool) -> str:
-    """The README's quality table, as `pendulum accuracy` measured it."""
+    """docs/certified-renders.md's quality table, as `pendulum accuracy` measured it."""
     d = rows[0]["duration"]
     lines = [f"Each `--quality` level on `{FLAGSHIP}` ({'quick mode, ' if quick else ''}{d:g} s of video), "
              "from `pendulum accuracy` (out/accuracy/quality.md). Target: the median pendulum stays faithful "

@@ -85,7 +85,7 @@ def step(sys: ti.template(), q, v, h):
 @ti.func
 def symplectic_euler(sys: ti.template(), q, v, h):
     """The seed's v += a·h; x += v·h. Symplectic for a separable system (springs) only: on the rigid chain
-    (θ, ω) are not canonical, so its energy error grows slowly (see README, Accuracy vs. time)."""
+    (θ, ω) are not canonical, so its energy error grows slowly (see docs/accuracy.md)."""
     v += h * sys.force(q, v)
     return q + h * v, v
 

@@ -26,7 +26,7 @@ class System(runtime.Launcher):
     # ---- the declaration (class attributes: read without a Taichi runtime) ----
     SYSTEM = ""  # the preset's `system` value
     NAME = ""  # prefix of this system's kernel names in metadata ("rigid_advance")
-    DOC = ""  # one line for `pendulum presets` and the README
+    DOC = ""  # one line for `pendulum presets` and docs/presets.md
     D = 0  # coordinates per pendulum in q (and v)
     LINKS: tuple[str, ...] = ()  # drawing contract: what joins pivot→bob 1→bob 2...: "rod" | "spring"
     ANGLES = False  # q holds the links' angles (a fractal can colour by them)
