@@ -113,7 +113,8 @@ def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.Pat
     "integrator.precision=f32,f64", or a list of those; without it, the preset's own [compare] table.
     Writes OUT/compare/NAME/; the result's metadata has every variant under "compare"."""
     scene = _scene(scene)
-    check_arch(arch), check_threads(threads)  # before the variants are built
+    check_arch(arch)  # before the variants are built
+    check_threads(threads)
     if isinstance(vary, str):
         vary = [vary]
     if isinstance(vary, dict):
@@ -121,7 +122,7 @@ def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.Pat
         for key, val in vary.items():
             _flatten(key, val, values)
         scene = comparison.with_table(scene, values)
-    elif isinstance(vary, (list, tuple)) and vary and all(isinstance(v, str) for v in vary):
+    elif isinstance(vary, (list, tuple)) and all(isinstance(v, str) for v in vary):  # [] as no --vary
         scene = comparison.with_vary(scene, list(vary))
     elif vary is not None:
         raise SceneError(f"vary={type(vary).__name__}: must be a dict {{KEY: [V1, V2]}}, a string 'KEY=V1,V2' as "
