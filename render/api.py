@@ -17,7 +17,7 @@ from pathlib import Path
 
 from . import budget, comparison, pipeline, registry, scene as scenes
 from .errors import SceneError
-from .options import check_writable
+from .options import check_arch, check_out_folder, check_replaceable, check_threads, check_writable
 from .results import RenderResult, Trajectory
 
 
@@ -41,6 +41,8 @@ def _flatten(key: str, value, out: dict) -> None:
         for k, v in value.items():
             _flatten(f"{key}.{k}", v, out)
         return
+    if key in out:  # {"video.fps": 30, "video": {"fps": 60}}: neither may silently win
+        raise SceneError(f"{key}: given twice (once dotted, once in a nested dict); give it once")
     out[key] = _plain(value)
 
 
@@ -57,14 +59,11 @@ def _scene(scene) -> scenes.Scene:
 
 
 def check_render(scene_list, out: Path) -> None:
-    """Refuse (SceneError) before any work: an output root that cannot be written, a NAME there that is a
-    file, a scene over the budget."""
+    """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder), a
+    scene over the budget."""
     out = Path(out)
-    check_writable(out)
     for scene in scene_list:
-        folder = scene.out_dir(out)
-        if folder.exists() and not folder.is_dir():
-            raise SceneError(f"--out {out}: {folder} is a file; {scene.name} renders into a folder of that name")
+        check_out_folder(scene, out)
         budget.check(scene, registry.get(scene.system), out)
 
 
@@ -73,7 +72,7 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
     """Render a Scene (or a preset name) into OUT/NAME/: MP4 and GIF as the scene's formats say, and
     metadata.json. Returns the paths, the metadata and the faithfulness certificate."""
     scene = _scene(scene)
-    out = Path(out)
+    arch, threads, out = check_arch(arch), check_threads(threads), Path(out)
     check_render([scene], out)
     meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
     return RenderResult(scene, scene.out_dir(out), meta)
@@ -85,14 +84,15 @@ def check_npz(out: Path, name: str) -> None:
         raise SceneError(f"--out {out}: must end in .npz")
     if out.is_dir():
         raise SceneError(f"--out {out}: is a directory; give the file to write, e.g. {out / name}.npz")
-    check_writable(out.parent)
+    check_writable(out.parent, f"--out {out}: its folder")
+    check_replaceable(out)
 
 
 def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
              progress: bool = False) -> Trajectory:
     """Simulate a Scene (or a preset name) without drawing: the state at every frame time, as the .npz of
     `pendulum simulate` holds it. Nothing is written unless `out` names a .npz file."""
-    scene = _scene(scene)
+    scene, arch = _scene(scene), check_arch(arch)
     out = Path(out) if out is not None else None
     if out is not None:
         check_npz(out, scene.name)
@@ -106,17 +106,27 @@ def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
     return Trajectory(scene, info.pop("arrays", {}), info, out)
 
 
-def compare(scene, vary: dict | None = None, out: str | os.PathLike = "out", *, arch: str = "cpu",
+def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.PathLike = "out", *, arch: str = "cpu",
             threads: int | None = None, progress: bool = False) -> RenderResult:
     """The split-screen comparison `pendulum compare` renders: `vary` maps dotted keys to one value per panel
-    (2 to 4), paired key by key, e.g. {"integrator.precision": ["f32", "f64"]}; without it, the preset's own
-    [compare] table. Writes OUT/compare/NAME/; the result's metadata has every variant under "compare"."""
+    (2 to 4), paired key by key, e.g. {"integrator.precision": ["f32", "f64"]}, or is what --vary takes,
+    "integrator.precision=f32,f64", or a list of those; without it, the preset's own [compare] table.
+    Writes OUT/compare/NAME/; the result's metadata has every variant under "compare"."""
     scene = _scene(scene)
-    if vary is not None:
+    check_arch(arch)  # before the variants are built
+    check_threads(threads)
+    if isinstance(vary, str):
+        vary = [vary]
+    if isinstance(vary, dict):
         values = {}
         for key, val in vary.items():
             _flatten(key, val, values)
         scene = comparison.with_table(scene, values)
+    elif isinstance(vary, (list, tuple)) and all(isinstance(v, str) for v in vary):  # [] as no --vary
+        scene = comparison.with_vary(scene, list(vary))
+    elif vary is not None:
+        raise SceneError(f"vary={type(vary).__name__}: must be a dict {{KEY: [V1, V2]}}, a string 'KEY=V1,V2' as "
+                         f"--vary takes it, or a list of such strings")
     elif not scene.compare:
         raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give vary={{KEY: [V1, V2]}}")
     return render(scene, out, arch=arch, threads=threads, progress=progress)

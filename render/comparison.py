@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import batch, pipeline
 from .errors import SceneError
-from .options import add_render_options, check_writable, output_name, progress_wanted
+from .options import add_render_options, check_out_folder, output_name, progress_wanted
 from .scene import from_dict, load, parse_override
 from .vary import VARIANTS, VARYING, vary_refusal
 
@@ -96,10 +96,8 @@ def run(args) -> int:
     # comparison the preset states.
     overridden = bool(args.overrides or args.quality or (given.compare and scene.compare != given.compare))
     scene = output_name(scene, overridden, args.name)
-    check_writable(args.out)
+    check_out_folder(scene, args.out)
     out_dir = scene.out_dir(args.out)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise SceneError(f"--out {args.out}: {out_dir} is a file; the comparison renders into a folder of that name")
     budget.check(scene, registry.get(scene.system), args.out)
     meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
     print(summary(meta, out_dir))

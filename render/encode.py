@@ -10,6 +10,7 @@ them). The pipes are enlarged so a writer hands over a frame in a few system cal
 """
 from __future__ import annotations
 
+import errno
 import math
 import os
 import queue
@@ -84,6 +85,17 @@ def gif_repeats(video, frames: int) -> list[int]:
 
 ARGS = {"mp4": mp4_args, "gif": gif_args}
 
+# What ffmpeg reports in the system's own words (av_strerror is strerror) when the file system fails it: then
+# the user reads that reason and the file, as for any other write, not ffmpeg's account of its muxer.
+FILE_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM,
+               errno.ENOENT, errno.ESTALE)
+
+
+def os_error(log: str) -> int | None:
+    """The errno of the first file-system error an ffmpeg log names, if any."""
+    found = [(log.find(os.strerror(code)), code) for code in FILE_ERRORS if os.strerror(code) in log]
+    return min(found)[1] if found else None
+
 
 class _Still:
     """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
@@ -93,7 +105,10 @@ class _Still:
 
     def finish(self):
         import imageio.v3 as iio
-        iio.imwrite(self.tmp, self.frame, extension=".png")
+        try:
+            iio.imwrite(self.tmp, self.frame, extension=".png")
+        except OSError as e:  # name the file the user asked for, not the hidden temporary
+            raise OSError(e.errno, e.strerror, str(self.final)) from e
 
 
 class _Target:
@@ -184,7 +199,11 @@ class Encoder:
         """
         for t in self.targets:
             if t.error is not None:
-                raise EncodeError(f"ffmpeg stopped: {self._logs() or t.error}")
+                try:
+                    t.proc.wait(timeout=5)  # its pipe broke as it exits: its log is then complete
+                except subprocess.TimeoutExpired:
+                    pass
+                raise self._failure("stopped", t.error)
         for t in self.targets:
             for _ in range(1 if t.repeats is None else t.repeats[self.written]):
                 t.queue.put(frame)
@@ -205,9 +224,9 @@ class Encoder:
         codes = [t.proc.wait() for t in self.targets]
         errors = [t.error for t in self.targets if t.error is not None]
         if errors or any(codes):
-            msg = self._logs() or str(errors[0] if errors else f"exit status {max(codes)}")
+            failure = self._failure("failed", errors[0] if errors else f"exit status {max(codes)}")
             self.abort()
-            raise EncodeError(f"ffmpeg failed: {msg}")
+            raise failure
         try:
             for s in self.stills:
                 s.finish()
@@ -241,12 +260,21 @@ class Encoder:
             s.tmp.unlink(missing_ok=True)
         self.targets, self.stills = [], []
 
-    def _logs(self) -> str:
-        out = []
-        for t in self.targets:
-            t.log.seek(0)
-            out.append(t.log.read().decode(errors="replace").strip())
-        return " | ".join(x.splitlines()[-1] for x in out if x)
+    def _failure(self, how: str, fallback) -> Exception:
+        """What to raise when an ffmpeg process failed: the OS's reason and the file when the file system
+        failed it (OSError, e.g. "No space left on device: out/NAME/NAME.mp4"), else EncodeError with the
+        last line of each ffmpeg's log."""
+        logs = [self._log(t) for t in self.targets]
+        for t, log in zip(self.targets, logs):
+            code = os_error(log)
+            if code is not None:
+                return OSError(code, os.strerror(code), str(t.final))
+        return EncodeError(f"ffmpeg {how}: {' | '.join(x.splitlines()[-1] for x in logs if x) or fallback}")
+
+    @staticmethod
+    def _log(t: _Target) -> str:
+        t.log.seek(0)
+        return t.log.read().decode(errors="replace").strip()
 
 
 def ffmpeg_version() -> str:

@@ -1,16 +1,28 @@
 """What several commands share on their command line: common options, their value types and the
-output-directory probe."""
+output probes. The Python API (render/api.py) checks its arguments with the same functions."""
 from __future__ import annotations
 
 import argparse
+import errno
+import numbers
+import os
 import re
+import stat
+import struct
 import sys
 import tempfile
 from pathlib import Path
 
+try:
+    import fcntl
+except ImportError:  # not POSIX
+    fcntl = None
+
 from .errors import SceneError
 from .quality import LEVELS
-from .validate import NAME_MAX, NAME_PATTERN
+from .validate import NAME_MAX, NAME_PATTERN, clip
+
+ARCHES = ("cpu", "cuda")  # runtime.init's backends (never ti.gpu)
 
 # Taichi starts one OS thread per thread asked for: 4096 started in under a second here, 100000 hung.
 # Beyond 1024 a CPU render only oversubscribes the cores.
@@ -20,7 +32,7 @@ MAX_THREADS = 1024
 def add_common(p):
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a preset key, dotted, value in TOML (e.g. --set integrator.dt=1e-4); repeatable")
-    p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu",
+    p.add_argument("--arch", choices=ARCHES, default="cpu",
                    help="Taichi backend; cuda falls back to the CPU with a warning where there is none")
 
 
@@ -87,19 +99,102 @@ def thread_count(text: str) -> int:
     return positive_int(text, MAX_THREADS)
 
 
+def check_arch(arch) -> str:
+    """The API's arch=: what --arch accepts (SceneError otherwise)."""
+    if not isinstance(arch, str) or arch not in ARCHES:
+        raise SceneError(f"arch={clip(repr(arch))}: must be one of {', '.join(ARCHES)}")
+    return arch
+
+
+def check_threads(threads) -> int | None:
+    """The API's threads=: None (all cores) or what --threads accepts (SceneError otherwise)."""
+    if threads is None:
+        return None
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+        raise SceneError(f"threads={clip(repr(threads))}: must be an integer from 1 to {MAX_THREADS}, or None for "
+                         f"all cores")
+    try:
+        return thread_count(str(int(threads)))
+    except argparse.ArgumentTypeError as e:
+        raise SceneError(f"threads={clip(repr(threads))}: {e}") from None
+
+
 def check_writable(path: Path, what: str = "--out"):
     """Bad input if the output cannot be created; checked before any work so nothing is half-written."""
     if "\0" in str(path):  # no file system takes it; pathlib would only fail later, in mkdir
         raise SceneError(f"{what} {str(path)!r}: a path cannot contain a NUL character")
     probe = path
     while not probe.exists():
+        if probe.is_symlink():  # a link to nothing, or a loop: no folder can be made there
+            try:
+                os.stat(probe)
+            except OSError as e:
+                raise SceneError(f"{what} {path}: not a writable directory ({probe} -> {os.readlink(probe)}: "
+                                 f"{e.strerror or e})") from None
         probe = probe.parent
+    if not probe.is_dir():
+        raise SceneError(f"{what} {path}: not a writable directory ({probe} is a file)")
     try:
-        if not probe.is_dir():
-            raise NotADirectoryError(probe)
         tempfile.TemporaryFile(dir=probe).close()  # os.access says yes to root even where writing fails
+    except OSError as e:
+        raise SceneError(f"{what} {path}: not a writable directory ({probe}: cannot create a file there: "
+                         f"{e.strerror or e})") from None
+
+
+def check_out_folder(scene, out: Path):
+    """Bad input before any work: OUT cannot be written, the scene's folder there (OUT/NAME/, a comparison's
+    OUT/compare/NAME/) or OUT/compare/ is a file or cannot be written, or an output file in it cannot be
+    replaced. Each would fail only after the simulation."""
+    check_writable(out)
+    folder = scene.out_dir(out)
+    for above in (folder, folder.parent):
+        if above != out and above.exists() and not above.is_dir():
+            raise SceneError(f"--out {out}: {above} is a file; {scene.name} renders into {folder}{os.sep}")
+    check_writable(folder)  # e.g. an immutable OUT/NAME/
+    for name in [*(f"{scene.name}.{fmt}" for fmt in scene.video.formats), "metadata.json"]:
+        check_replaceable(folder / name)
+
+
+def check_replaceable(path: Path, what: str = "--out"):
+    """Bad input if `path` is a file that is there and cannot be replaced by renaming a finished file onto it
+    (render/atomic.py), which would fail only after the work. Even root cannot replace an immutable or
+    append-only file (chattr +i, +a); no one but its owner, the folder's or root one in a sticky folder."""
+    try:
+        st, folder = os.lstat(path), os.stat(Path(path).parent)
     except OSError:
-        raise SceneError(f"{what} {path}: not a writable directory ({probe})") from None
+        return  # not there: check_writable judges its folder
+    why = None
+    if _pinned(path, st):
+        why = "the file is immutable or append-only; lsattr shows which"
+    elif folder.st_mode & stat.S_ISVTX and os.geteuid() not in (0, st.st_uid, folder.st_uid):
+        why = "another user's file in a sticky folder"
+    if why:
+        raise SceneError(f"{what} {path}: cannot be replaced: {os.strerror(errno.EPERM)} ({why})")
+
+
+# Linux's FS_IOC_GETFLAGS, _IOR('f', 1, long), and the flags of chattr's +i and +a.
+FS_IOC_GETFLAGS = 2 << 30 | struct.calcsize("l") << 16 | ord("f") << 8 | 1
+FS_IMMUTABLE_FL, FS_APPEND_FL = 0x10, 0x20
+
+
+def _pinned(path: Path, st: os.stat_result) -> bool:
+    """Whether a file is immutable or append-only: st_flags on BSD and macOS, the inode's flags on Linux."""
+    flags = getattr(st, "st_flags", None)
+    if flags is not None:
+        return bool(flags & (stat.UF_IMMUTABLE | stat.UF_APPEND | stat.SF_IMMUTABLE | stat.SF_APPEND))
+    if not sys.platform.startswith("linux") or not stat.S_ISREG(st.st_mode):
+        return False  # a symlink is replaced itself, whatever it points to
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        flags = int.from_bytes(fcntl.ioctl(fd, FS_IOC_GETFLAGS, bytes(8))[:4], sys.byteorder)
+    except OSError:  # a file system without inode flags
+        return False
+    finally:
+        os.close(fd)
+    return bool(flags & (FS_IMMUTABLE_FL | FS_APPEND_FL))
 
 
 def progress_wanted(args) -> bool:

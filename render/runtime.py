@@ -14,7 +14,6 @@ import warnings
 
 import taichi as ti
 
-ARCHES = ("cpu", "cuda")
 _current: tuple | None = None
 _generation = 0  # how many times Taichi was (re)initialised: fields of an older generation are gone
 launched: list[str] = []  # kernel names in first-launch order, since the last init

@@ -14,9 +14,10 @@ Keys: space pauses and resumes (at the end it plays again from the start), → s
 (or closing the window) quits with exit 0. Playback is paced at the preset's fps, or as fast as frames come
 when they come slower. At the end of the video the last frame stays up.
 
-Without an X display (no DISPLAY, or one that cannot be opened) the command exits 2 with one line that
-suggests `pendulum render`. This is checked with libX11's XOpenDisplay before Taichi is asked for a window:
-Taichi itself would only fail after compiling the scene, and it logs its own error line on stderr.
+Without an X display (no DISPLAY, one that cannot be opened, or one that does not answer within
+DISPLAY_TIMEOUT_S) the command exits 2 with one line that suggests `pendulum render`. This is checked with
+libX11's XOpenDisplay before Taichi is asked for a window: Taichi itself would only fail after compiling the
+scene, and it logs its own error line on stderr.
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ import os
 import shlex
 import struct
 import sys
+import threading
 import time
 import zlib
 from pathlib import Path
@@ -36,9 +38,10 @@ import numpy as np
 from . import pipeline
 from .atomic import write_atomic
 from .errors import SceneError
-from .options import add_common, add_quality
+from .options import add_common, add_quality, thread_count
 from .scene import load
 
+DISPLAY_TIMEOUT_S = 5.0  # a display that has not answered by then will not: a local one answers in ms
 POLL_S = 1 / 60  # longest wait between looks at the keyboard (keys are read when the window is updated)
 
 # Taichi's names for the keys (ti.GUI.SPACE, ti.GUI.RIGHT, ti.GUI.ESCAPE, ti.GUI.EXIT), checked in open_window.
@@ -206,10 +209,27 @@ def check_display(suggest: str) -> XConnection:
     x11.XOpenDisplay.restype = ctypes.c_void_p
     x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
     x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
-    conn = x11.XOpenDisplay(display.encode())
+    conn = open_display(x11, display)
+    if conn is None:
+        raise NoDisplay(f"show: display {display!r} did not answer within {DISPLAY_TIMEOUT_S:g} s; {hint}")
     if not conn:
         raise NoDisplay(f"show: cannot open display {display!r}; {hint}")
     return XConnection(x11, conn)
+
+
+def open_display(x11, display: str, timeout: float = DISPLAY_TIMEOUT_S):
+    """XOpenDisplay's answer (0 when it fails), or None when none came within `timeout`.
+
+    XOpenDisplay waits without end on a server that accepts the connection and never answers, and while it
+    waits in C no Python signal handler runs: SIGTERM would be ignored. So it runs in a daemon thread while
+    this one waits, interruptibly; one still waiting when the process exits is simply dropped with it.
+    """
+    result = []
+    opener = threading.Thread(target=lambda: result.append(x11.XOpenDisplay(display.encode())),
+                              name="XOpenDisplay", daemon=True)
+    opener.start()
+    opener.join(timeout)
+    return (result[0] or 0) if result else None
 
 
 class quiet_fds:
@@ -322,7 +342,7 @@ def add_parser(sub):
     add_common(s)
     s.add_argument("--out", type=Path, default=Path("out"), help="where s saves frames (default: out)")
     add_quality(s)
-    s.add_argument("--threads", type=int, default=None, help="CPU threads for Taichi (default: all cores)")
+    s.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     s.set_defaults(func=run)
 
 

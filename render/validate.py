@@ -17,7 +17,7 @@ import re
 from . import grid, keys, registry
 from .errors import SceneError
 from .quality import LEVELS
-from .vary import PANEL_MIN, VARIANTS, VARYING, dotted, frozen, plain, vary_refusal
+from .vary import PANEL_MIN, VARIANTS, VARYING, Twice, dotted, frozen, plain, vary_refusal
 
 SYSTEMS = registry.names()
 METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
@@ -324,8 +324,12 @@ class Validator:
         if not isinstance(table["vary"], dict) or not table["vary"]:
             self.fail("compare.vary", f"must be a table of KEY = [V1, V2, ...], got {tname(table['vary'])}")
         known = sorted(dotted({k: v for k, v in d.items() if k != "compare"}))
+        try:
+            flat = dotted(table["vary"])
+        except Twice as e:
+            self.fail(f"compare.vary.{show_key(e.key)}", "given twice (quoted, and dotted or as a table); give it once")
         out = []
-        for key, values in dotted(table["vary"]).items():
+        for key, values in flat.items():
             name = f"compare.vary.{show_key(key)}"
             if key not in known:  # hinted among the keys a comparison may vary
                 self.fail(name, "unknown key" + hint(key, [k for k in known if not vary_refusal(k)]))

@@ -17,14 +17,24 @@ PANEL_MIN = 16  # pixels a panel keeps on each side (the smallest video)
 VARYING = "a comparison varies integrator.method, dt or precision, quality, or the physics under [pendulums]"
 
 
+class Twice(ValueError):
+    """A table names one dotted key twice: quoted and dotted (`"integrator.dt"` and `integrator.dt`), or
+    quoted and as a sub-table ([compare.vary.integrator] dt). TOML sees two keys; one would silently win."""
+
+    def __init__(self, key: str):
+        super().__init__(key)
+        self.key = key
+
+
 def dotted(table: dict, prefix: str = "") -> dict:
-    """A nested table as {dotted key: value}: TOML's `integrator.dt = ...` and `"integrator.dt" = ...` alike."""
+    """A nested table as {dotted key: value}: TOML's `integrator.dt = ...` and `"integrator.dt" = ...` alike.
+    Raises Twice when both name the same key."""
     out = {}
     for k, v in table.items():
-        if isinstance(v, dict):
-            out.update(dotted(v, f"{prefix}{k}."))
-        else:
-            out[prefix + k] = v
+        for key, val in (dotted(v, f"{prefix}{k}.") if isinstance(v, dict) else {prefix + k: v}).items():
+            if key in out:
+                raise Twice(key)
+            out[key] = val
     return out
 
 

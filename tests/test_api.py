@@ -163,3 +163,67 @@ def test_compare_renders_the_split_screen_and_refuses_what_cannot_vary(tmp_path)
         render.compare(scene, out=tmp_path / "no")
     assert not (tmp_path / "no").exists()
     assert callable(render.compare)  # the function, not a module of that name
+
+
+# ------------------------------------------------------------------ the API checks what the CLI checks
+class Ran(Exception):
+    """Raised by a stand-in for the pipeline: the call got past every check."""
+
+
+@pytest.fixture
+def no_pipeline(monkeypatch):
+    """pipeline.render and .simulate replaced: a refusal must come before them; what reaches them is kept."""
+    seen = []
+
+    def stand_in(scene, *args, **kwargs):
+        seen.append((scene, kwargs))
+        raise Ran()
+
+    monkeypatch.setattr(render.api.pipeline, "render", stand_in)
+    monkeypatch.setattr(render.api.pipeline, "simulate", stand_in)
+    return seen
+
+
+VARY = {"integrator.precision": ["f32", "f64"]}
+
+
+@pytest.mark.parametrize("call, kwargs, needles", [
+    ("render", {"arch": "tpu"}, ["arch='tpu'", "cpu, cuda"]),
+    ("simulate", {"arch": "gpu"}, ["arch='gpu'", "cpu, cuda"]),
+    ("compare", {"arch": "opengl", "vary": VARY}, ["arch='opengl'"]),
+    ("render", {"threads": 0}, ["threads=0", "positive integer up to 1024"]),
+    ("render", {"threads": 1025}, ["threads=1025", "up to 1024"]),
+    ("compare", {"threads": -2, "vary": VARY}, ["threads=-2", "up to 1024"]),
+    ("render", {"threads": "2"}, ["threads='2'", "an integer from 1 to 1024"]),
+    ("render", {"threads": 2.0}, ["threads=2.0", "an integer"]),
+    ("render", {"threads": True}, ["threads=True", "an integer"]),
+    ("compare", {"vary": 42}, ["vary=int", "a dict", "--vary"]),
+    ("compare", {"vary": "integrator.dt=1e-3"}, ["--vary integrator.dt", "1 value(s)", "2 to 4"]),
+    ("compare", {"vary": ["integrator.tolerance=1e-3,1e-2"]}, ["--vary integrator.tolerance", "cannot vary"]),
+    ("compare", {"vary": {"integrator.dt": [1e-3, 5e-4], "integrator": {"dt": [2e-3, 5e-4]}}},
+     ["integrator.dt", "given twice"]),
+])
+def test_the_api_refuses_what_the_cli_refuses_before_any_work(tmp_path, no_pipeline, call, kwargs, needles):
+    scene = render.load("rigid_chaos", **SMALL)
+    with pytest.raises(SceneError) as e:
+        getattr(render, call)(scene, out=tmp_path / ("o.npz" if call == "simulate" else "o"), **kwargs)
+    assert all(n in str(e.value) for n in needles) and "\n" not in str(e.value), str(e.value)
+    assert no_pipeline == [] and not any(tmp_path.iterdir())
+
+
+def test_load_refuses_a_key_given_dotted_and_nested():
+    with pytest.raises(SceneError, match="video.fps: given twice"):
+        render.load("classic", video={"fps": 30}, **{"video.fps": 60})
+
+
+def test_compare_takes_the_clis_vary_strings_as_the_dict(tmp_path, no_pipeline):
+    scene = render.load("rigid_chaos", **SMALL)
+    as_dict = {"integrator.method": ["rk4", "rk2"], "integrator": {"dt": [1e-3, 5e-4]}}
+    for vary in (as_dict, ["integrator.method=rk4,rk2", "integrator.dt=1e-3,5e-4"]):
+        with pytest.raises(Ran):
+            render.compare(scene, vary=vary, out=tmp_path, threads=np.int64(2))
+    with pytest.raises(Ran):
+        render.compare(scene, vary="integrator.dt=1e-3,5e-4", out=tmp_path)
+    (a, kw), (b, _), (c, _) = no_pipeline
+    assert a.compare == b.compare == (("integrator.method", ("rk4", "rk2")), ("integrator.dt", (1e-3, 5e-4)))
+    assert c.compare == (("integrator.dt", (1e-3, 5e-4)),) and kw["threads"] == 2 and kw["arch"] == "cpu"
