@@ -215,7 +215,7 @@ class Section(runtime.Launcher):
     def summary(self) -> dict:
         """For metadata.json."""
         return {"section": "theta1 = 0 mod 2 pi, omega1 > 0", "points": "(theta2, omega2)", "crossings": self.total,
-                "lost": self.lost, "omega2_range": [-self.top, self.top]}
+                "lost": self.lost, "omega2_range": [-round(self.top, 6), round(self.top, 6)]}
 
     @ti.kernel
     def poincare_plot(self):
