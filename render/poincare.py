@@ -25,7 +25,6 @@ import numpy as np
 import taichi as ti
 
 from . import axes, reference, runtime
-from .canvas import to_byte
 from .errors import SceneError
 from .font import Font
 
@@ -240,6 +239,7 @@ class Section(runtime.Launcher):
         for y, x in ti.ndrange(self.side, self.side):
             c = self.layer[y, x]
             if c.max() > 0.0:
-                for ch in ti.static(range(3)):  # over the background: a max of the bytes (in i32: no u8 max)
-                    b = ti.max(ti.cast(out[self.py + y, self.px + x, ch], ti.i32), ti.cast(to_byte(c[ch]), ti.i32))
+                for ch in ti.static(range(3)):  # the canvas's byte over the background, a max (in i32: no u8 max)
+                    b = ti.max(ti.cast(out[self.py + y, self.px + x, ch], ti.i32),
+                               ti.cast(ti.min(c[ch], 1.0) * 255.0 + 0.5, ti.i32))
                     out[self.py + y, self.px + x, ch] = ti.cast(b, ti.u8)
