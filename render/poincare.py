@@ -82,7 +82,8 @@ def read(sim, t0: float) -> tuple[np.ndarray, ...]:
 
 # ------------------------------------------------------------------ the shell start and the ω2 range (host)
 def quadratic(p, th2: np.ndarray, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """E(ω1) = A·ω1² + B·ω1 + C on the section θ1 = 0 at each (θ2, ω2): the reference energy at ω1 = 0, ±1."""
+    """E(ω1) = A·ω1² + B·ω1 + C on the section θ1 = 0 at each (θ2, ω2), from the reference energy at
+    ω1 = 0, ±1."""
     q = np.stack([np.zeros_like(th2), th2], 1)
     e = [reference.energy(p, q, np.stack([np.full_like(w2, w1), w2], 1)) for w1 in (0.0, 1.0, -1.0)]
     return 0.5 * (e[1] + e[2]) - e[0], 0.5 * (e[1] - e[2]), e[0]
@@ -195,7 +196,8 @@ class Section(runtime.Launcher):
             x = x0 + min(round(s * k / 4), s - 1)
             bg[y0 + s + 1:y0 + s + 1 + pad, x] = axes.FRAME
             if k % 2 == 0 or s // 4 >= 6 * cw:
-                texts.append((axes.pi_label(-math.pi + k * math.pi / 2), x, y0 + s + 2 * pad, {**small, "ha": "center"}))
+                texts.append((axes.pi_label(-math.pi + k * math.pi / 2), x, y0 + s + 2 * pad,
+                              {**small, "ha": "center"}))
         for v in ticks(self.top, max(1, min(3, s // (4 * ch)))):  # ω2 in rad/s, labels two lines apart
             y = y0 + min(round((self.top - v) / (2 * self.top) * s), s - 1)
             bg[y, max(x0 - 1 - pad, 0):x0 - 1] = axes.FRAME
