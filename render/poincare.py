@@ -119,9 +119,9 @@ def shell_start(scene, th: np.ndarray, w: np.ndarray):
     p = reference.params(scene)
     energy = float(reference.energy(p, th[:1], w[:1])[0])
     if not energy > 0.0:
-        raise SceneError(f"{scene.source}: pendulums: layout \"shell\" starts pendulums with the energy of "
-                         f"theta1, theta2, omega1, omega2, which is {energy:g} J here: the hanging rest, where "
-                         f"the section is a point; give a start with some energy")
+        raise SceneError(f"{scene.source}: pendulums.layout: \"shell\" starts pendulums with the energy of "
+                         f"theta1, theta2, omega1, omega2, which is {energy:g} J here (the hanging rest, where "
+                         f"the section is a point); give a start with some energy")
     th_max = reach(p, energy)
     w_max = omega2_range(p, energy, th_max)
     n, found, k = len(th), [], 0

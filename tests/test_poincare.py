@@ -127,7 +127,7 @@ def test_the_section_needs_two_link_angles():
 def test_a_shell_at_rest_and_the_effect_on_springs_exit_2_with_one_line(tmp_path):
     springs = ["--set", 'system="elastic"', "--set", "pendulums.stiffness=1e3",
                "--set", 'effects=["springs", "poincare"]']
-    for args, needle in ((["--set", "pendulums.omega1=0"], "pendulums: layout \"shell\""), (springs, "'poincare'")):
+    for args, needle in ((["--set", "pendulums.omega1=0"], "pendulums.layout: \"shell\""), (springs, "'poincare'")):
         r = run_cli("render", "poincare_shell", "--out", tmp_path, "--no-progress", *args)
         assert r.returncode == 2, r.stderr
         assert len(r.stderr.strip().splitlines()) == 1, r.stderr
