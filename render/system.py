@@ -223,17 +223,22 @@ class System(runtime.Launcher):
             for lane in range(B):
                 i = ti.min(g * B + lane, self.n - 1)
                 Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+            Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
             if ti.static(self.poincare):
                 for lane in range(B):
                     if g * B + lane < self.n:
                         self.crossed[g * B + lane] = 0
             for s in range(substeps):
+                if ti.static(self.poincare):
+                    Q0, V0 = Q, V
                 for lane in range(B):  # the loop LLVM vectorises
-                    q0, v0 = ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]])
-                    q, v = integrators.step(self, q0, v0, h)
-                    if ti.static(self.poincare):
-                        poincare.detect(self, g * B + lane, s, q0, v0, q, v, h)
+                    q, v = integrators.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
                     Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                if ti.static(self.poincare):  # in a loop of its own, so that its branch leaves the step's SIMD
+                    for lane in range(B):
+                        poincare.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                                        ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
+                                        ti.Matrix.cols([V[:, lane]]), h)
             for lane in range(B):
                 i = g * B + lane
                 if i < self.n:
