@@ -48,6 +48,7 @@ figures: $(BIN)/pendulum
 	$(BIN)/python benchmarks/effects.py --clock cpu --out out/bench/effects.md
 	$(BIN)/python benchmarks/frame.py rigid_chaos --at 10 --out out/figures/hud_rigid_chaos.png
 	$(BIN)/python benchmarks/frame.py rainbow_1000 --at 5 --out out/figures/glow_rainbow_1000.png
+	$(BIN)/python benchmarks/frame.py poincare_shell --at 60 --size 1280x720 --out out/figures/poincare_shell.png
 	$(BIN)/python benchmarks/compare_still.py
 	$(BIN)/python benchmarks/readme_figures.py
 

@@ -25,6 +25,7 @@ IMAGES = {  # out/<source> -> benchmarks/figures/<name>
     "accuracy/faithful_rigid_chaos.png": "faithful_rigid_chaos.png",
     "figures/hud_rigid_chaos.png": "hud_rigid_chaos.png",  # benchmarks/frame.py: one frame, as render draws it
     "figures/glow_rainbow_1000.png": "glow_rainbow_1000.png",
+    "figures/poincare_shell.png": "poincare_shell.png",
     "fractal_flip_readme/fractal_flip_readme.png": "fractal_flip.png",
     "figures/compare_precision.png": "compare_precision.png",  # benchmarks/compare_still.py
 }

@@ -64,8 +64,15 @@ class Canvas(runtime.Launcher):
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
         self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
-        # pixels per metre, the pivot at the centre: the full reach fits with a margin
-        self.scale = 0.46 * min(self.w, self.h) / sim.reach()
+        self.section, area = None, self.w  # the pendulums' width of the frame: all of it, or left of the section
+        if scene.has("poincare"):
+            from .poincare import Section
+            from .validate import DRAWN
+            area = self.w // 2 if any(scene.has(e) for e in DRAWN) else 0
+            self.section = Section(self, scene, sim, area, self.w - area)
+        self.cx, self.cy = 0.5 * area, 0.5 * self.h
+        # pixels per metre, the pivot at the centre of its area: the full reach fits with a margin
+        self.scale = 0.46 * min(area or self.w, self.h) / sim.reach()
         self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
         self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
         self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
@@ -86,6 +93,8 @@ class Canvas(runtime.Launcher):
     def restart(self):
         """Back to the first frame: no trail yet."""
         self.frame_no = 0
+        if self.section is not None:
+            self.section.restart()
         if self.trails:
             self.trail.fill(0)
             self.lit.fill(0)
@@ -112,6 +121,8 @@ class Canvas(runtime.Launcher):
         if self.bobs_on:
             self.launch("draw_bobs")
         self.launch("compose_frame", out)
+        if self.section is not None:
+            self.section.draw(out, self.frame_no == 0)
         if self.hud is not None:
             self.hud.draw(out, self.frame_no / self.fps if t is None else t)
         self.frame_no += 1
@@ -208,7 +219,7 @@ class Canvas(runtime.Launcher):
     @ti.func
     def joint(self, i, j: ti.template()):
         """Where link j of pendulum i starts: the pivot, or the previous bob."""
-        a = ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32)
+        a = ti.Vector([self.cx, self.cy], ti.f32)
         if ti.static(j > 0):
             a = self.pos[i, j - 1]
         return a
@@ -216,7 +227,7 @@ class Canvas(runtime.Launcher):
     @ti.kernel
     def bob_pixels(self):
         """The system's chain points, world metres to pixels (y down), at frame times only."""
-        cx, cy = 0.5 * self.w, 0.5 * self.h
+        cx, cy = self.cx, self.cy
         for i in range(self.n):
             pts = self.sim.points(self.sim.q[i])
             for j in ti.static(range(len(self.links))):
@@ -274,7 +285,7 @@ class Canvas(runtime.Launcher):
         for i in range(self.n):
             for j in ti.static(range(len(self.links))):
                 self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0))
-        self.disc(ti.Vector([0.5 * self.w, 0.5 * self.h], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
+        self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
 
     @ti.kernel
     def compose_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):

@@ -179,6 +179,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen, sha256)
         if scene.fractal:
             meta["map"] = src.canvas.summary()
+        if scene.has("poincare"):
+            meta["poincare"] = src.canvas.section.summary()
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 

@@ -13,7 +13,7 @@ contract (LINKS, bob_sizes(), reach(), lengths).
 import numpy as np
 import taichi as ti
 
-from . import budget, grid, integrators, keys, runtime
+from . import budget, grid, integrators, keys, poincare, runtime
 from .sincos import sincos
 from .errors import SimulationError
 
@@ -56,6 +56,7 @@ class System(runtime.Launcher):
         self.libm = scene.integrator.trig == "libm"
         self.damped = scene.has("damping")
         self.damping = p.damping
+        self.poincare = scene.has("poincare")  # crossings of the section recorded per substep (render/poincare.py)
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
         q0, v0 = self.initial_state()
@@ -73,6 +74,8 @@ class System(runtime.Launcher):
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
         self.bad = runtime.field("watchdog.bad", ti.i32, ())
+        if self.poincare:
+            poincare.allocate(self)
         self.load(q0, v0)
         if scene.has("energy"):
             self.floor = self.energy_floor()
@@ -87,6 +90,8 @@ class System(runtime.Launcher):
         self.q.from_numpy(q0.astype(dtype))
         self.v.from_numpy(v0.astype(dtype))
         self.bad[None] = self.n
+        if self.poincare:
+            self.crossed.fill(0)
         self.t = 0.0
 
     def restart(self):
@@ -137,6 +142,8 @@ class System(runtime.Launcher):
         w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
         if p.layout == "grid":
             th, w = grid.grid_state(self.scene, th, w)
+        elif p.layout == "shell":
+            poincare.shell_start(self.scene, th, w)
         else:
             th[:, -1] = th[:, -1] - p.spread * np.arange(n, dtype=np.float64) / n
         return th, w
@@ -216,10 +223,22 @@ class System(runtime.Launcher):
             for lane in range(B):
                 i = ti.min(g * B + lane, self.n - 1)
                 Q[:, lane], V[:, lane] = self.q[i], self.v[i]
-            for _ in range(substeps):
+            Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
+            if ti.static(self.poincare):
+                for lane in range(B):
+                    if g * B + lane < self.n:
+                        self.crossed[g * B + lane] = 0
+            for s in range(substeps):
+                if ti.static(self.poincare):
+                    Q0, V0 = Q, V
                 for lane in range(B):  # the loop LLVM vectorises
                     q, v = integrators.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
                     Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                if ti.static(self.poincare):  # in a loop of its own, so that its branch leaves the step's SIMD
+                    for lane in range(B):
+                        poincare.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                                        ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
+                                        ti.Matrix.cols([V[:, lane]]), h)
             for lane in range(B):
                 i = g * B + lane
                 if i < self.n:
@@ -234,8 +253,13 @@ class System(runtime.Launcher):
         differently in the chunked loop, and in f32 from upright those bits decide the chaos)."""
         for i in range(self.n):
             q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
-            for _ in range(substeps):
+            if ti.static(self.poincare):
+                self.crossed[i] = 0
+            for s in range(substeps):
+                q0, v0 = q, v
                 q, v = integrators.step(self, q, v, h)
+                if ti.static(self.poincare):
+                    poincare.detect(self, i, s, q0, v0, q, v, h)
             self.q[i], self.v[i] = q[:, 0], v[:, 0]
             if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
                 ti.atomic_min(self.bad[None], i)

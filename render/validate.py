@@ -24,7 +24,7 @@ METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
 PRECISIONS = ("f32", "f64")
 TRIGS = ("inline", "libm")  # integrator.trig: render/sincos.py, or the C library's (bit for bit as the seed)
 FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
-LAYOUTS = ("fan", "grid")
+LAYOUTS = ("fan", "grid", "shell")  # shell: on one energy shell, on the Poincaré section (render/poincare.py)
 FRACTALS = ("angles", "flip_time", "divergence")  # how a map (effects = ["fractal"]) colours its pixels
 MAP_DEFAULTS = {  # [map]: fractal maps only
     "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
@@ -33,7 +33,7 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
 }
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 # New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow")
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare")
 DRAWN = ("rods", "springs", "bobs", "trails")  # effects that draw the pendulums (glow composes these)
 PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/canvas.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
@@ -173,6 +173,9 @@ class Validator:
         effects = self.effects(d, system, pend, fractal)
         if "fractal" in effects and fractal is None:
             fractal = "angles"
+        if "poincare" in effects and d.get("compare") is not None:
+            self.fail("compare", "a Poincaré section is drawn from crossings found as the pendulums are stepped, "
+                      "which a comparison's panels do not record; render each variant with --set instead")
         return {"name": name, "description": description, "system": system, "quality": quality,
                 "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
                 "fractal": fractal, "map": self.map(d, fractal), "compare": self.compare(d, pend, video, fractal)}
@@ -295,11 +298,19 @@ class Validator:
                           + ")")
             if pend["layout"] != "grid":
                 self.fail("effects", "'fractal' colours one pendulum per pixel and needs pendulums.layout = \"grid\"")
-            clash = [e for e in eff if e in DRAWN + ("hud", "glow")]
+            clash = [e for e in eff if e in DRAWN + ("hud", "glow", "poincare")]
             if clash:
                 self.fail("effects", f"'fractal' fills every pixel; it cannot be combined with {clash}")
         elif pend["layout"] == "grid":
             self.fail("pendulums.layout", "a grid of pendulums is drawn with effects = [\"fractal\"]")
+        section = [n for n in SYSTEMS if registry.get(n).ANGLES and len(registry.get(n).LINKS) == 2]
+        if "poincare" in eff and system not in section:
+            self.fail("effects", "'poincare' draws the section θ1 = 0 of a double pendulum's two angles as "
+                      "(θ2, ω2) points, and this system has no such section (systems with two link angles: "
+                      f"{', '.join(section)})")
+        if pend["layout"] == "shell" and system not in section:
+            self.fail("pendulums.layout", "'shell' starts pendulums on the section θ1 = 0 of a double pendulum's two "
+                      f"angles, and this system has none (systems with two link angles: {', '.join(section)})")
         if "glow" in eff and not any(e in eff for e in DRAWN):
             self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
