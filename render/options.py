@@ -148,6 +148,8 @@ def check_out_folder(scene, out: Path):
     check_writable(out)
     folder = scene.out_dir(out)
     for above in (folder, folder.parent):
+        if above != out and above.is_symlink():  # it may lead out of OUT, and a run writes only inside OUT
+            raise SceneError(f"--out {out}: {above} is a symlink; {scene.name} renders only inside {out}{os.sep}")
         if above != out and above.exists() and not above.is_dir():
             raise SceneError(f"--out {out}: {above} is a file; {scene.name} renders into {folder}{os.sep}")
     check_writable(folder)  # e.g. an immutable OUT/NAME/

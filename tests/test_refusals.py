@@ -94,6 +94,17 @@ def test_compare_into_an_out_whose_compare_is_a_file_is_refused_up_front(tmp_pat
     assert tree(out) == ["compare"] and (out / "compare").read_text().startswith("a file")
 
 
+def test_render_into_a_folder_that_is_a_symlink_out_of_out_is_refused_up_front(tmp_path):
+    """OUT/NAME/ a symlink to a folder elsewhere: the render would write there, outside OUT."""
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "classic").symlink_to(elsewhere)
+    r = cli(tmp_path, "render", "classic", "--name", "classic", "--out", out, *SMALL)
+    refused(r, tmp_path, f"--out {out}", f"{out / 'classic'} is a symlink")
+    assert tree(elsewhere) == [] and tree(out) == ["classic"]
+
+
 # ------------------------------------------------------------------ 3. outputs even root cannot write
 def test_simulate_onto_an_immutable_file_is_refused_up_front(tmp_path):
     target = tmp_path / "t.npz"
