@@ -99,10 +99,12 @@ def test_render_into_a_folder_that_is_a_symlink_out_of_out_is_refused_up_front(t
     out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
     out.mkdir()
     elsewhere.mkdir()
-    (out / "classic").symlink_to(elsewhere)
-    r = cli(tmp_path, "render", "classic", "--name", "classic", "--out", out, *SMALL)
-    refused(r, tmp_path, f"--out {out}", f"{out / 'classic'} is a symlink")
-    assert tree(elsewhere) == [] and tree(out) == ["classic"]
+    (out / "small").symlink_to(elsewhere)
+    preset = tmp_path / "small.toml"  # the preset as written (no --set), so it renders into OUT/small/
+    preset.write_text((ROOT / "presets" / "classic.toml").read_text().replace("duration = 20.0", "duration = 1.0"))
+    r = cli(tmp_path, "render", preset, "--out", out)
+    refused(r, tmp_path, f"--out {out}", f"{out / 'small'} is a symlink")
+    assert tree(elsewhere) == [] and tree(out) == ["small"]
 
 
 # ------------------------------------------------------------------ 3. outputs even root cannot write
