@@ -24,8 +24,8 @@ from pathlib import Path
 from . import budget, gallery, registry
 from .atomic import write_atomic
 from .errors import BatchError, SceneError
-from .options import (add_common, add_quality, check_writable, output_name, positive_int, progress_wanted,
-                      thread_count)
+from .options import (add_budget, add_common, add_quality, budgeted, check_writable, output_name, positive_int,
+                      progress_wanted, thread_count)
 from .scene import SCHEMA, list_presets, load, parse_override, preset_path
 from .version import __version__
 
@@ -50,6 +50,7 @@ def add_parser(sub):
     b.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="render one variant per value (OUT/NAME__KEY_VALUE); repeat for a grid")
     add_quality(b)
+    add_budget(b)
     b.add_argument("--threads", type=thread_count, default=None,
                    help="Taichi CPU threads per render (default: cores / jobs locally, all cores on Dask)")
     b.add_argument("--digest", action="store_true",
@@ -286,6 +287,7 @@ def run(args) -> int:
     for job in jobs_plan:
         if "scene" in job:
             try:  # what each render costs, refused before any work as a bad preset is
+                job["scene"] = budgeted(job["scene"], args)
                 budget.check(job["scene"], registry.get(job["scene"].system), out_root)
             except SceneError as e:
                 job["error"] = str(e)
@@ -295,6 +297,8 @@ def run(args) -> int:
             rows[job["name"]] = gallery.row_from_meta(job["name"], "skipped", meta, None)
         else:
             todo.append(job["scene"])
+    if todo:
+        budget.check_run(todo, out_root)  # the renders to do, summed: refused together before the first
     n, done = len(jobs_plan), 0
 
     def report(row):

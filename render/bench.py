@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import peers, reference
+from . import estimate, peers, reference
 from .atomic import write_atomic
 from .errors import SimulationError
 from .options import check_writable
@@ -49,7 +49,9 @@ def add_parser(sub):
     p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal",
                        description="Measure simulation throughput (Taichi vs numpy), drawing and encoding fps, "
                                    "an end-to-end render against the encode-only floor, and the fractal maps; "
-                                   "write OUT/report.md and OUT/report.json.")
+                                   "write OUT/report.md, OUT/report.json and OUT/rates.json: this machine's rates, from "
+                                   "which `render --out DIR` estimates its run time when they are DIR/bench/rates.json "
+                                   "(the default out/bench serves the default out).")
     p.add_argument("--quick", action="store_true", help="small N ladder and short videos (about 30 s)")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
@@ -75,6 +77,9 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
     write_atomic(args.out / "report.md", markdown(report).encode())
+    # This machine's rates for the run-time budget of renders into the OUT above (render/estimate.py)
+    rates = {**estimate.measured(res, chaos_scene(cfg)), "created": report["created"], "quick": report["quick"]}
+    write_atomic(args.out / "rates.json", (json.dumps(rates, indent=2) + "\n").encode())
     m = report["machine"]
     write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
         targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "

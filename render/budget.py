@@ -2,35 +2,43 @@
 exit 2) when it is beyond a limit. Each refusal quotes the estimate and the limit. Refuse, don't attempt:
 a run that cannot finish should not start, take hours, and then fail or freeze.
 
-Three estimates, all in Python ints (64-bit and beyond, never a wrapped 32-bit counter):
-- steps = frames × substeps × pendulums ≤ STEP_LIMIT, and substeps per frame ≤ SUBSTEP_LIMIT (the advance
-  kernel counts them in an i32: beyond it the count wrapped to 0 and the video froze);
+Three estimates, each against a limit stated as a share of what this machine has or of the time allowed:
+- time: the seconds of every part of the run (render/estimate.py: simulation, the certificate's shadow,
+  the --quality pilots, drawing and encoding, from this machine's rates) ≤ the budget: the scene's `budget`
+  key or --budget, DEFAULT_LIMIT_S otherwise. A run of several scenes (`render A B`, `batch`, a
+  comparison's panels) is held to the sum. Runs estimated over ANNOUNCE_S say so before they start;
 - memory: the state fields, the canvas and the frames a run holds at once: frames queued for ffmpeg, and
   every GIF frame, which ffmpeg keeps until the palette is known at the end; `simulate` keeps every frame's
   state until it writes the file. Limit: MEMORY_FRACTION of the machine's physical memory;
-- output: bytes written (MP4 and GIF, or the .npz). Limit: the free space where they go.
+- output: bytes written (MP4 and GIF, or the .npz). Limit: DISK_FRACTION of the free space where they go.
+Counts are Python ints (64-bit and beyond, never a wrapped 32-bit counter); the substeps per frame must fit
+the advance kernel's i32 (SUBSTEP_LIMIT: beyond it the count wrapped to 0 and the video froze).
 
-check() runs before any work (the CLI and batch call it for every scene before the first render); the
-System calls check_steps() again once the stable step is known, since "auto" depends on the physics.
+check() runs before any work (the CLI, compare and batch call check_run() for all their scenes before the
+first render). It plans the step the System settles on ("auto" depends on the physics) without building a
+Taichi field or kernel; the System checks its substeps again when it is built.
 """
 from __future__ import annotations
 
+import functools
+import json
 import math
 import os
 import re
 import shutil
+import sys
 from pathlib import Path
 
 from .encode import QUEUE_FRAMES
 from .errors import SceneError
 from .integrators import AUTO_DT
+from .keys import BUDGET_MAX
 
-# 1e11 pendulum-steps is about two hours of simulation on a 2-core CPU (13 M rigid RK4 steps/s at N = 1e5,
-# README "Performance") and still above every shipped use: the full fractal preset takes 1.1e9, `bench`
-# builds rigid_chaos with 1e6 pendulums (2e10).
-STEP_LIMIT = 10 ** 11
+DEFAULT_LIMIT_S = 3600.0  # "about one hour" (DESIGN.md, round 3); a scene's `budget` key or --budget raises it
+ANNOUNCE_S = 60.0  # a run estimated longer prints its estimate before it starts
 SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
 MEMORY_FRACTION = 0.8  # of physical memory: beyond it the machine swaps or the kernel kills the run
+DISK_FRACTION = 0.9  # of the free space: the rest is left for the system and the temporary files beside
 FALLBACK_MEMORY = 8 << 30  # where the physical memory cannot be read
 # Output sizes per pixel of each frame, about twice the largest measured here (fractal: MP4 0.027,
 # GIF 0.53 bytes per pixel; the swinging presets compress 10 to 30 times better), so the estimate errs high.
@@ -39,10 +47,13 @@ GIF_BYTES_PER_PIXEL = 1.0
 GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 until palettegen has seen all
 
 
-def check(scene, system, out: Path | None, simulate: bool = False) -> None:
-    """Refuse `scene` if its steps, memory or output exceed the limits. `system` is its System class (for
-    the size of its state); `out` is where the output goes (a folder, or the .npz's folder), None when
-    nothing is written (the API's simulate without a file)."""
+def check(scene, system, out: Path | None, simulate: bool = False):
+    """Refuse `scene` if its memory, output or time exceed the limits; return its time estimate. `system` is
+    its System class (for the size of its state); `out` is where the output goes (a folder, or the .npz's
+    folder; its bench/rates.json gives this machine's rates), None when nothing is written (the API's
+    simulate without a file)."""
+    from . import estimate as estimates  # it plans Systems, and system.py imports this module
+
     src = scene.source
     need, key, detail = memory(scene, system, simulate)
     limit, total = memory_limit()
@@ -52,43 +63,123 @@ def check(scene, system, out: Path | None, simulate: bool = False) -> None:
     need, key, detail = output(scene, system, simulate)
     where = existing(Path(out)) if out is not None else None
     free = shutil.disk_usage(where).free if where is not None else math.inf
-    if need > free:
-        raise SceneError(f"{src}: {key}: the output needs about {size(need)} of disk ({detail}), "
-                         f"{size(free)} free in {where}")
-    # A pinned dt gives its substeps now; "auto" at least those of AUTO_DT (stiffness only adds more), as
-    # integrators.timestep rounds them. The System checks again with the step it settles on.
-    dt = AUTO_DT if scene.integrator.dt == "auto" else scene.integrator.dt
-    # A subnormal dt gives fps·dt = 0 once Taichi has started (its CPU runtime sets the FPU's denormal
-    # flags for the whole process), or 1/(fps·dt) = inf before: either way, more substeps than anything holds.
-    per_frame = scene.video.fps * dt
-    ratio = 1.0 / per_frame if per_frame > 0 else math.inf
-    substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
-    check_steps(scene, substeps, 1.0 / (scene.video.fps * substeps))
-    for variant in scene.variants() if scene.compare else ():  # each panel at its own step
-        check(variant, system, out, simulate)
+    if need > DISK_FRACTION * free:
+        raise SceneError(f"{src}: {key}: the output needs about {size(need)} of disk ({detail}), more than "
+                         f"{DISK_FRACTION:.0%} of the {size(free)} free in {where}")
+    for variant in scene.variants() if scene.compare else [scene]:
+        # A pinned dt gives its substeps before any planning: a subnormal one gives fps·dt = 0 once Taichi has
+        # started (its CPU runtime sets the FPU's denormal flags for the whole process), or 1/(fps·dt) = inf.
+        dt = variant.integrator.dt
+        if dt != "auto":
+            per_frame = variant.video.fps * dt
+            ratio = 1.0 / per_frame if per_frame > 0 else math.inf
+            substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
+            check_steps(variant, substeps, 1.0 / (variant.video.fps * substeps))
+    rates, source = estimates.load_rates(out)
+    est = _estimate(scene, json.dumps(rates, sort_keys=True), source, simulate)
+    if est.total > limit_s(scene):
+        raise SceneError(refusal(scene, est, limit_s(scene)))
+    return est
+
+
+def check_run(scenes: list, out: Path | None, simulate: bool = False) -> float:
+    """check() every scene, then hold their sum to the run's limit (the largest of theirs); print the estimate
+    on stderr when it is over ANNOUNCE_S. Returns the estimated seconds."""
+    ests = [check(s, _system(s), out, simulate) for s in scenes]
+    total, limit = sum(e.total for e in ests), max(limit_s(s) for s in scenes)
+    if len(scenes) > 1 and total > limit:
+        names = ", ".join(s.name for s in scenes[:3]) + (", ..." if len(scenes) > 3 else "")
+        raise SceneError(f"{len(scenes)} renders ({names}): estimated {duration(total)} together "
+                         f"({breakdown(ests)}), over the run-time budget of {duration(limit)}; render fewer at once, "
+                         f"or {raise_by(total)}")
+    if total > ANNOUNCE_S:
+        what = scenes[0].name if len(scenes) == 1 else f"{len(scenes)} renders"
+        print(f"pendulum: {what}: estimated {duration(total)} ({breakdown(ests)}), within the budget of "
+              f"{duration(limit)}", file=sys.stderr, flush=True)
+    return total
+
+
+@functools.lru_cache(maxsize=64)
+def _estimate(scene, rates: str, source: str, simulate: bool):
+    """estimate.estimate, once per scene and rates: a render is checked by the CLI, then by the API."""
+    from . import estimate as estimates
+    return estimates.estimate(scene, json.loads(rates), source, simulate)
+
+
+def _system(scene):
+    from . import registry
+    return registry.get(scene.system)
+
+
+def limit_s(scene) -> float:
+    return scene.budget if scene.budget is not None else DEFAULT_LIMIT_S
+
+
+def refusal(scene, est, limit: float) -> str:
+    """One line: the keys that drive the estimate, the estimate by part, the limit, and how to get under it."""
+    steps = (f"{num(est.steps)} steps ({est.frames} frames x {est.substeps} substeps of {est.h:.3g} s x "
+             f"{est.pendulums} pendulum{'s' * (est.pendulums != 1)}{f' x {est.panels} panels' * bool(est.panels)})")
+    over = (f"{f'{est.panels} panels ' * bool(est.panels)}estimated {duration(est.total)} ({breakdown([est])}), "
+            f"over the run-time budget of {duration(limit)}")
+    src, dt = scene.source, scene.integrator.dt
+    usual = max(1, math.ceil(1.0 / (scene.video.fps * AUTO_DT)))  # the same scene at dt = 1e-3
+    at_usual = est.total - est.physics * (1 - usual / est.substeps) if est.substeps > usual else math.inf
+    if est.physics + est.links_s < est.total - est.physics - est.links_s:
+        keys, why = "video.width, video.height, video.duration", over
+        fix = "use a smaller or shorter video, or a lower video.fps"
+    elif est.physics < est.links_s:  # drawing the pendulums, frame after frame
+        keys, why = "pendulums.count, video.duration", over
+        fix = "use fewer pendulums, a shorter video or a lower video.fps"
+    elif dt == "auto" and at_usual <= limit and not scene.compare:
+        keys, fix = "integrator.dt", "use softer springs or heavier bobs, or fewer pendulums"
+        why = (f"\"auto\" needs steps of {est.h:.3g} s for this scene's fastest rate, and {steps} are {over}; "
+               f"stiff springs, or light bobs under heavy ones or on tiny links, are the usual cause")
+    elif dt != "auto" and at_usual <= limit:
+        keys, why, fix = "integrator.dt", f"dt too small: {steps} are {over}", "use a larger integrator.dt"
+    else:
+        keys, why = "pendulums.count, video.duration", f"{steps} are {over}"
+        fix = "use fewer pendulums, a shorter video or a lower video.fps"
+    return f"{src}: {keys}: {why}; {fix}, or {raise_by(est.total)}"
+
+
+def raise_by(total: float) -> str:
+    """How to allow `total` seconds, or that no budget does."""
+    if total > BUDGET_MAX:
+        return f"no budget allows it (at most {duration(BUDGET_MAX)})"
+    wanted = min(BUDGET_MAX, math.ceil(total / 3600) * 3600 if total > 3000 else math.ceil(total / 600) * 600)
+    text = f"{wanted // 3600:.0f}h" if wanted >= 3600 else f"{wanted // 60:.0f}min"
+    return f"raise the budget: --budget {text} (or budget = \"{text}\" in the preset)"
+
+
+def breakdown(ests: list) -> str:
+    """'start 10 s, simulate 40 s, certificate 1 min 5 s, draw+encode 2 min; built-in rates'."""
+    parts = {}
+    for e in ests:
+        for k, s in e.parts.items():
+            parts[k] = parts.get(k, 0.0) + s
+    sources = sorted({e.rates for e in ests})
+    return ", ".join(f"{k} {duration(s)}" for k, s in parts.items() if s >= 0.5) + "; " + ", ".join(sources)
+
+
+def duration(s: float) -> str:
+    """Seconds for a message: '42 s', '3 min 20 s', '2 h 5 min', '1.2e+04 h'."""
+    if s < 59.5:
+        return f"{s:.0f} s"
+    if s < 3570:
+        m, r = divmod(round(s), 60)
+        return f"{m} min {r} s" if r else f"{m} min"
+    if s < 100 * 3600:
+        h, m = divmod(round(s / 60), 60)
+        return f"{h} h {m} min" if m else f"{h} h"
+    return f"{s / 3600:.3g} h"
 
 
 def check_steps(scene, substeps: int, h: float) -> None:
-    """Refuse a scene whose frames × substeps × pendulums exceed STEP_LIMIT (or whose substeps per frame
-    overflow the kernel's counter), naming what made it so."""
-    frames, n = scene.frames, scene.pendulums.count
-    steps = frames * substeps * n
-    if steps <= STEP_LIMIT and substeps <= SUBSTEP_LIMIT:
+    """Refuse substeps per frame beyond the kernel's i32 counter (the time budget refuses long runs)."""
+    if substeps <= SUBSTEP_LIMIT:
         return
-    dt = scene.integrator.dt
-    what = (f"{num(steps)} steps ({frames} frames x {substeps} substeps of {h:.3g} s x {n} "
-            f"pendulum{'s' * (n != 1)}) exceed the step budget of {num(STEP_LIMIT)}")
-    if steps <= STEP_LIMIT:
-        what = f"{substeps} substeps per frame exceed the step counter's limit of {SUBSTEP_LIMIT}"
-    usual = frames * max(1, math.ceil(1.0 / (scene.video.fps * AUTO_DT))) * n  # the same scene at dt = 1e-3
-    if dt == "auto" and usual <= STEP_LIMIT:
-        raise SceneError(f"{scene.source}: integrator.dt: \"auto\" needs steps of {h:.3g} s for this scene's "
-                         f"fastest rate, and {what}; stiff springs, or light bobs under heavy ones or on tiny "
-                         f"links, are the usual cause")
-    if dt != "auto" and (usual <= STEP_LIMIT or substeps > SUBSTEP_LIMIT):
-        raise SceneError(f"{scene.source}: integrator.dt: dt too small: {what}; use a larger integrator.dt")
-    raise SceneError(f"{scene.source}: pendulums.count, video.duration: {what}; use fewer pendulums, "
-                     f"a shorter video or a lower video.fps")
+    raise SceneError(f"{scene.source}: integrator.dt: dt too small: {substeps} substeps per frame of {h:.3g} s "
+                     f"exceed the step counter's limit of {SUBSTEP_LIMIT}; use a larger integrator.dt")
 
 
 def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
@@ -160,11 +251,8 @@ def existing(path: Path) -> Path:
 
 
 def num(x: int) -> str:
-    """A count for a message: 2.45e11, or every digit where rounding would make it read as the limit."""
-    if x < 1e6:
-        return str(x)
-    short = re.sub(r"e\+0*", "e", f"{x:.3g}")  # 3.79e+08 -> 3.79e8
-    return short if float(short) != STEP_LIMIT or x == STEP_LIMIT else f"{x:,}"
+    """A count for a message: 2.45e11, or every digit below a million."""
+    return str(x) if x < 1e6 else re.sub(r"e\+0*", "e", f"{x:.3g}")  # 3.79e+08 -> 3.79e8
 
 
 def size(b: int) -> str:

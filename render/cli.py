@@ -15,7 +15,7 @@ from pathlib import Path
 
 from . import accuracy, batch, bench, comparison, gallery, lyapunov_cli, show
 from .errors import BatchError, EncodeError, SceneError, SimulationError
-from .options import add_common, add_quality, add_render_options, output_name, progress_wanted
+from .options import add_budget, add_common, add_quality, add_render_options, budgeted, output_name, progress_wanted
 
 # Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
 MODULES = (accuracy, batch, bench, comparison, gallery, lyapunov_cli, show)
@@ -54,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", type=Path, required=True, metavar="FILE.npz")
     add_common(s)
     add_quality(s)
+    add_budget(s)
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_simulate)
 
@@ -68,14 +69,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_render(args) -> int:
-    from . import api
+    from . import api, budget
 
-    scenes = [api.load(p, *args.overrides, quality=args.quality) for p in args.presets]  # all validated first
+    scenes = [budgeted(api.load(p, *args.overrides, quality=args.quality), args) for p in args.presets]  # all first
     if args.name and len(scenes) > 1:
         raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
     overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
     scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
     api.check_render(scenes, args.out)  # every scene's refusals before the first render
+    budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
     for scene in scenes:
         result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
         print(result.line())
@@ -94,9 +96,11 @@ def distinct(scenes: list, out: Path) -> list:
 
 
 def cmd_simulate(args) -> int:
-    from . import api
+    from . import api, budget
 
-    scene = api.load(args.preset, *args.overrides, quality=args.quality)
+    scene = budgeted(api.load(args.preset, *args.overrides, quality=args.quality), args)
+    api.check_npz(args.out, scene.name)
+    budget.check_run([scene], args.out.parent, simulate=True)  # the estimate, when over a minute
     traj = api.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
     print(f"{scene.name}: {traj.info['frames']} frames, {traj.info['line']} -> {args.out}")
     return 0

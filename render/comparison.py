@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import batch, pipeline
 from .errors import SceneError
-from .options import add_render_options, check_out_folder, output_name, progress_wanted
+from .options import add_render_options, budgeted, check_out_folder, output_name, progress_wanted
 from .scene import from_dict, load, parse_override
 from .vary import VARIANTS, VARYING, vary_refusal
 
@@ -88,7 +88,7 @@ def with_table(scene, vary: dict):
 
 
 def run(args) -> int:
-    from . import budget, registry
+    from . import budget
 
     given = load(args.preset, args.overrides, args.quality)
     scene = with_vary(given, args.vary)
@@ -98,7 +98,7 @@ def run(args) -> int:
     scene = output_name(scene, overridden, args.name)
     check_out_folder(scene, args.out)
     out_dir = scene.out_dir(args.out)
-    budget.check(scene, registry.get(scene.system), args.out)
+    budget.check_run([budgeted(scene, args)], args.out)  # every panel's parts, summed
     meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
     print(summary(meta, out_dir))
     return 0

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,7 +33,7 @@ class Reals:
 # at 1e4 rad/s (1600 turns a second, 27 per 60 fps frame) is no longer a picture. Lengths (m) and masses
 # (kg) within [1e-6, 1e6]: twelve decades, and the products the equations form (m·l²·ω², g·m·l, the
 # triple's determinant ~ (m·l²)³) stay far inside f64's range (f32 drafts are held to [1e-3, 1e3] by
-# render/validate.py); what a tiny or stiff scene costs in steps is the step budget's to refuse
+# render/validate.py); what a tiny or stiff scene costs in time is the run-time budget's to refuse
 # (render/budget.py), not a range's.
 ANGLE_MAX = 1e3
 RATE_MAX = 1e4
@@ -49,3 +50,37 @@ def chain(links: int, extra: dict | None = None) -> dict:
     keys["lengths"] = Reals((1.0,) * links, SIZE_MIN, SIZE_MAX)
     keys["masses"] = Reals((1.0,) * links, SIZE_MIN, SIZE_MAX)
     return {**keys, **(extra or {})}
+
+
+# The run-time budget (top-level `budget`, or --budget): the longest a run may be estimated to take before it
+# is refused (render/budget.py; the default is budget.DEFAULT_LIMIT_S). At least a second; at most two days,
+# far below the week after which an unfinished render's partial files count as abandoned (render/atomic.py).
+BUDGET_MIN, BUDGET_MAX = 1.0, 2 * 24 * 3600.0
+DURATION_UNITS = {"s": 1, "sec": 1, "m": 60, "min": 60, "h": 3600, "hr": 3600, "d": 86400}
+_DURATION = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*([a-z]+)\s*")
+
+
+def seconds(value) -> float | None:
+    """A duration in seconds: a number (seconds) or a text such as "90", "90 s", "20 min", "2h", "1h30m";
+    None when it is neither (or not finite)."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        try:
+            value = float(value)
+        except OverflowError:
+            return None
+        return value if math.isfinite(value) else None
+    if not isinstance(value, str) or not value.strip() or len(value) > 40:
+        return None
+    text = value.strip().lower()
+    try:
+        return float(text) if math.isfinite(float(text)) else None
+    except ValueError:
+        pass
+    total, at = 0.0, 0
+    for m in _DURATION.finditer(text):
+        if m.start() != at or m.group(2) not in DURATION_UNITS:
+            return None
+        total, at = total + float(m.group(1)) * DURATION_UNITS[m.group(2)], m.end()
+    return total if at == len(text) else None

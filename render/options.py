@@ -19,6 +19,7 @@ except ImportError:  # not POSIX
     fcntl = None
 
 from .errors import SceneError
+from .keys import BUDGET_MAX, BUDGET_MIN, seconds
 from .quality import LEVELS
 from .validate import NAME_MAX, NAME_PATTERN, clip
 
@@ -37,12 +38,13 @@ def add_common(p):
 
 
 def add_render_options(p):
-    """What `render` and `compare` share after the preset: --set/--arch, --out, --name, --quality, --threads
-    and --no-progress."""
+    """What `render` and `compare` share after the preset: --set/--arch, --out, --name, --quality, --budget,
+    --threads and --no-progress."""
     add_common(p)
     p.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
     add_name(p)
     add_quality(p)
+    add_budget(p)
     p.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -52,6 +54,26 @@ def add_quality(p):
                    help="a guarantee instead of the preset's integrator: the median pendulum stays faithful for "
                         "50 %% (draft), 75 %% (standard) or 100 %% (high) of the video, met by the cheapest setting "
                         "that pilot runs show meets it; reference: the finest step")
+
+
+def add_budget(p):
+    p.add_argument("--budget", type=budget_seconds, metavar="TIME",
+                   help="the longest the run may be estimated to take, in seconds or e.g. 90min or 2h (default: the "
+                        "preset's budget key, or 1 h); a run estimated longer is refused before it starts")
+
+
+def budget_seconds(text: str) -> float:
+    """An argparse type: a run-time budget, as the preset's `budget` key takes it (render/keys.py)."""
+    secs = seconds(text)
+    if secs is None or not BUDGET_MIN <= secs <= BUDGET_MAX:
+        raise argparse.ArgumentTypeError(f"must be seconds or a duration such as 90min or 2h, from {BUDGET_MIN:g} s to "
+                                         f"{BUDGET_MAX / 3600:g} h, got {text[:40]!r}")
+    return secs
+
+
+def budgeted(scene, args):
+    """The scene under the --budget given (its own budget key otherwise)."""
+    return scene if getattr(args, "budget", None) is None else scene.replace(budget=args.budget)
 
 
 def add_name(p):

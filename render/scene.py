@@ -43,6 +43,7 @@ SCHEMA: dict[str, object] = {
     "system": REQUIRED,
     "effects": None,
     "quality": None,  # a level of render/quality.py: the integrator is then chosen by pilot runs
+    "budget": None,  # seconds (or "2h") a run may be estimated to take, beyond budget.DEFAULT_LIMIT_S
     "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
     "compare": None,  # a comparison: [compare] vary = { KEY = [V1, V2, ...] } (validate.py, split.py)
     "pendulums": pendulum_keys(None),
@@ -124,6 +125,7 @@ class Scene:
     fractal: str | None = None  # a map's colouring, None for a fan
     map: MapSpec | None = None
     compare: tuple | None = None  # ((dotted key, (value per panel, ...)), ...): a split-screen comparison
+    budget: float | None = None  # seconds; how long the run may take, not what it makes: not hashed
     source: str = dataclasses.field(default="", compare=False)
 
     @property
@@ -145,6 +147,8 @@ class Scene:
         if self.fractal is None:  # a fan has no map (its [map] is the defaults): it hashes as before maps
             d.pop("fractal")
             d.pop("map")
+        if self.budget is None:
+            d.pop("budget")
         if self.compare is None:
             d.pop("compare")  # a scene without a comparison hashes as it did before there were any
         else:
@@ -153,6 +157,7 @@ class Scene:
 
     def hash(self) -> str:
         d = self.to_dict()
+        d.pop("budget", None)  # the same frames under any budget: the same folder, up to date in `batch`
         if d["integrator"]["trig"] == "inline":  # the default of a key added later: scenes keep their hash
             del d["integrator"]["trig"]
         blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
@@ -273,7 +278,7 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     d = v.build(v.merge(raw, schema, ""))
     scene = Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
                   Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
-                  d["compare"], source=src)
+                  d["compare"], d["budget"], source=src)
     if scene.compare:
         scene.variants()  # every variant's values are validated with the preset, before any work
     return scene

@@ -177,8 +177,23 @@ class Validator:
             self.fail("compare", "a Poincaré section is drawn from crossings found as the pendulums are stepped, "
                       "which a comparison's panels do not record; render each variant with --set instead")
         return {"name": name, "description": description, "system": system, "quality": quality,
+                "budget": self.budget(d),
                 "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
                 "fractal": fractal, "map": self.map(d, fractal), "compare": self.compare(d, pend, video, fractal)}
+
+    def budget(self, d) -> float | None:
+        """The run-time budget in seconds (render/budget.py), a number or a text such as "2h" or "90 min"."""
+        val = d["budget"]
+        if val is None:
+            return None
+        secs = keys.seconds(val)
+        if secs is None:
+            self.fail("budget", f"must be a number of seconds or a duration such as \"90 min\" or \"2h\", got "
+                      f"{tname(val)}")
+        if not keys.BUDGET_MIN <= secs <= keys.BUDGET_MAX:
+            self.fail("budget", f"must be between {keys.BUDGET_MIN:g} s and {keys.BUDGET_MAX / 3600:g} h, got "
+                      f"{secs:g} s")
+        return secs
 
     def fractal(self, d, system) -> str | None:
         val = d["fractal"]

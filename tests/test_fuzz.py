@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import out_folder, run_cli
-from render import batch, budget, cli, pipeline, registry, runtime
+from render import batch, budget, cli, estimate, pipeline, registry, runtime
 from render.errors import SceneError
 from render.scene import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SCHEMA, SYSTEMS
 
@@ -286,9 +286,10 @@ def extremes(seed: int) -> list[str]:
 @pytest.mark.parametrize("seed", range(6))
 def test_valid_extremes_render_for_real_or_are_refused(tmp_path, monkeypatch, seed):
     """Heavy masses over light ones and strong gravity make the stable step tiny (omega_max bounds of 1e7
-    rad/s): such a scene is valid and within the real budget, and would run for minutes. A budget of 1e6
-    steps keeps each case to seconds; whatever exceeds it is refused up front (exit 2), as it would be."""
-    monkeypatch.setattr(budget, "STEP_LIMIT", 10 ** 6)
+    rad/s): such a scene is valid and within the real budget, and would run for minutes. A budget of a second
+    beyond a render's fixed start keeps each case to seconds; whatever exceeds it is refused up front (exit 2),
+    as it would be."""
+    monkeypatch.setattr(budget, "DEFAULT_LIMIT_S", estimate.RATES["fixed_s"] + 1.0)
     preset = tmp_path / "edge.toml"
     preset.write_text(toml_doc({**BASE, "video": {**BASE["video"], "duration": 0.3}}))
     argv = ["render", str(preset), "--out", str(tmp_path / "out"), "--no-progress"]
