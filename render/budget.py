@@ -124,10 +124,10 @@ def refusal(scene, est, limit: float) -> str:
     src, dt = scene.source, scene.integrator.dt
     usual = max(1, math.ceil(1.0 / (scene.video.fps * AUTO_DT)))  # the same scene at dt = 1e-3
     at_usual = est.total - est.physics * (1 - usual / est.substeps) if est.substeps > usual else math.inf
-    if est.physics + est.links_s < est.total - est.physics - est.links_s:
+    if est.physics + est.pendulums_s < est.total - est.physics - est.pendulums_s:
         keys, why = "video.width, video.height, video.duration", over
         fix = "use a smaller or shorter video, or a lower video.fps"
-    elif est.physics < est.links_s:  # drawing the pendulums, frame after frame
+    elif est.physics < est.pendulums_s:  # drawing (or writing) the pendulums, frame after frame
         keys, why = "pendulums.count, video.duration", over
         fix = "use fewer pendulums, a shorter video or a lower video.fps"
     elif dt == "auto" and at_usual <= limit and not scene.compare:

@@ -59,7 +59,9 @@ class Estimate:
     pendulums: int
     panels: int  # 0 unless a comparison
     rates: str  # where the rates came from
-    links_s: float = 0.0  # of draw+encode, what drawing the pendulums' links takes (the rest: per pixel, per frame)
+    # of draw+encode (or write), what grows with the pendulums: drawing their links (or writing their states);
+    # the rest is per pixel and per frame
+    pendulums_s: float = 0.0
 
     @property
     def total(self) -> float:
@@ -100,24 +102,21 @@ def estimate(scene, rates: dict, source: str = "", simulate: bool = False) -> Es
     System settles on ("auto" included) without any Taichi field, so it refuses what the System refuses."""
     cls = registry.get(scene.system)
     variants = scene.variants() if scene.compare else [scene]
-    parts = {"start": rates["fixed_s"] * (1 + len(variants) * bool(scene.compare))}
-    steps, finest = 0, None
+    panels = len(variants) if scene.compare else 0
+    parts = {"start": rates["fixed_s"] * (1 + panels)}
+    steps, finest = 0, (0, 0.0)
     for variant in variants:
         run, h, substeps = physics(variant, rates)
         for k, s in run.items():
             parts[k] = parts.get(k, 0.0) + s
-        steps += scene.frames * substeps * scene.pendulums.count
-        finest = max(finest or (0, h), (substeps, h))
+        steps += scene.frames * substeps * variant.pendulums.count
+        finest = max(finest, (substeps, h))
     if simulate:
-        per = scene.pendulums.count * (2 * cls.D + 1) * 8
-        parts["write"] = scene.frames * per * rates["npz_byte_s"]
+        parts["write"] = grows = scene.frames * scene.pendulums.count * (2 * cls.D + 1) * 8 * rates["npz_byte_s"]
     else:
-        panels = len(variants) * bool(scene.compare)
-        parts["draw+encode"] = scene.frames * picture_frame_s(scene, rates, panels)
-        links = scene.frames * picture_frame_s(scene, {**{k: 0 for k in RATES if k != "draw_link_s"},
-                                                       "draw_link_s": rates["draw_link_s"]}, panels)
-    return Estimate(parts, steps, scene.frames, finest[0], finest[1], scene.pendulums.count,
-                    len(variants) if scene.compare else 0, source, 0.0 if simulate else links)
+        per, links = picture_frame_s(scene, rates, panels)
+        parts["draw+encode"], grows = scene.frames * per, scene.frames * links
+    return Estimate(parts, steps, scene.frames, finest[0], finest[1], scene.pendulums.count, panels, source, grows)
 
 
 def physics(scene, rates: dict) -> tuple[dict, float, int]:
@@ -180,21 +179,22 @@ def pilots_s(scene, cands: list[dict], rates: dict) -> float:
     return total
 
 
-def picture_frame_s(scene, rates: dict, panels: int = 0) -> float:
-    """Seconds to draw and encode one frame: the canvas (a fixed cost, per pixel, per drawn link at the
-    panels' heights, the HUD), then x264 and the GIF's ffmpeg, each per pixel of the full frame."""
+def picture_frame_s(scene, rates: dict, panels: int = 0) -> tuple[float, float]:
+    """Seconds to draw and encode one frame, and of those what drawing the pendulums' links takes: the canvas
+    (a fixed cost, per pixel, per drawn link at the panels' heights, the HUD), then x264 and the GIF's ffmpeg,
+    each per pixel of the full frame."""
     from .split import layout
 
     v, cls = scene.video, registry.get(scene.system)
     pixels = v.width * v.height
     heights = [h for _, _, _, h in layout(v.width, v.height, panels)] if panels else [v.height]
     links = scene.pendulums.count * len(cls.LINKS) if any(scene.has(e) for e in DRAWN) else 0
-    per = (rates["draw_frame_s"] + pixels * rates["draw_pixel_s"] + rates["hud_frame_s"] * scene.has("hud")
-           + sum(links * rates["draw_link_s"] * h / REFERENCE_HEIGHT for h in heights))
+    links_s = sum(links * rates["draw_link_s"] * h / REFERENCE_HEIGHT for h in heights)
+    per = rates["draw_frame_s"] + pixels * rates["draw_pixel_s"] + rates["hud_frame_s"] * scene.has("hud") + links_s
     for fmt in ("mp4", "gif"):
         if fmt in v.formats:
             per += rates[f"{fmt}_frame_s"] + pixels * rates[f"{fmt}_pixel_s"]
-    return per
+    return per, links_s
 
 
 def measured(res: dict, chaos) -> dict:
@@ -215,7 +215,7 @@ def measured(res: dict, chaos) -> dict:
                               draw_only),
                              (("mp4_frame_s", "mp4_pixel_s", "gif_frame_s", "gif_pixel_s"), res["encode"]["encode_fps"],
                               encode_only)):
-        scale = (1.0 / fps) / picture_frame_s(chaos, model)
+        scale = (1.0 / fps) / picture_frame_s(chaos, model)[0]
         for k in keys:
             rates[k] = RATES[k] * scale
     rates["fixed_s"] = res["e2e"]["fixed_s"]
