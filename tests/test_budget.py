@@ -6,13 +6,14 @@ import io
 import json
 import math
 import re
+import resource
 import shutil
 import time
 from pathlib import Path
 
 import pytest
 
-from conftest import make_scene
+from conftest import make_scene, run_cli
 from render import api, budget, cli, comparison, estimate, keys, pipeline, registry, runtime
 from render.errors import SceneError
 
@@ -132,6 +133,19 @@ def test_stiff_light_springs_are_refused_by_the_time_they_take(tmp_path):
                          "pendulums.masses=[1e-6,1e-6]"], tmp_path / "out",
                         'elastic_fan.toml: integrator.dt: "auto" needs steps of 1.2', "stiff springs")
     assert "1200 frames x 1348" in line and "x 10 pendulums" in line
+
+
+def test_a_real_process_is_refused_within_5_s_of_cpu(tmp_path):
+    """As a user runs it: Python's start, the imports and the plan take a few CPU seconds (the wall time on a
+    loaded machine is the machine's, not the check's)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    r = run_cli("render", "triple_chaos", "--set", "integrator.dt=1e-7", "--out", tmp_path / "out", "--no-progress",
+                timeout=120)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 2 and len(lines) == 1 and "over the run-time budget of 1 h" in lines[0], r.stderr
+    assert cpu < 5.0 and not (tmp_path / "out").exists(), cpu
 
 
 def test_a_run_over_a_minute_prints_its_estimate_before_it_starts(tmp_path, no_render):
