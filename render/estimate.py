@@ -122,14 +122,13 @@ def estimate(scene, rates: dict, source: str = "", simulate: bool = False) -> Es
 def physics(scene, rates: dict) -> tuple[dict, float, int]:
     """({simulate, certificate[, quality]} seconds, step, substeps per frame) of one (non-comparison) scene."""
     plan = registry.get(scene.system)(scene, allocate=False)  # the stable step; refuses an unstable dt
-    parts = {}
-    if scene.quality is not None:
-        cands = quality.candidates(scene, plan.omega_max(*plan.initial_state()))
-        if cands:  # else quality.choose refuses the scene
-            parts["quality"] = pilots_s(scene, cands, rates)
-            worst = max(cands, key=lambda s: quality.cost(s, scene.video.fps))
-            scene = scene.replace(integrator={**worst, "allow_unstable": False})
-    h, substeps = (plan.h, plan.substeps) if scene.quality is None else pinned(scene, scene.integrator.dt)
+    parts, (h, substeps) = {}, (plan.h, plan.substeps)
+    cands = quality.candidates(scene, plan.omega_max(*plan.initial_state())) if scene.quality else []
+    if cands:  # (none: quality.choose refuses the scene)
+        parts["quality"] = pilots_s(scene, cands, rates)
+        worst = max(cands, key=lambda s: quality.cost(s, scene.video.fps))
+        scene = scene.replace(integrator={**worst, "allow_unstable": False})
+        h, substeps = pinned(scene, worst["dt"])
     i, n = scene.integrator, scene.pendulums.count
     parts["simulate"] = run_s(scene, rates, i.method, i.precision, substeps, n)
     certified = len(grid.trust_indices(scene)) if scene.fractal else min(n, certify.SUBSAMPLE)

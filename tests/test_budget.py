@@ -135,6 +135,24 @@ def test_stiff_light_springs_are_refused_by_the_time_they_take(tmp_path):
     assert "1200 frames x 1348" in line and "x 10 pendulums" in line
 
 
+def test_the_quality_pilots_count_and_the_costliest_choice_is_assumed():
+    """--quality: the pilots (a reference and a bisection per method and precision, each a kernel to compile),
+    and the render at the most expensive setting the pilots could choose."""
+    from render import quality
+    scene = api.load("elastic_fan", quality="high")
+    plan = registry.get(scene.system)(scene, allocate=False)
+    cands = quality.candidates(scene, plan.omega_max(*plan.initial_state()))
+    worst = max(cands, key=lambda c: quality.cost(c, scene.video.fps))
+    est = estimate.estimate(scene, RATES)
+    ladders = {(c["method"], c["precision"]) for c in cands}
+    assert est.parts["quality"] > RATES["compile_s"] * (len(ladders) + 1)
+    substeps = math.ceil(1 / (scene.video.fps * worst["dt"]) - 1e-9)
+    assert est.substeps == substeps and est.parts["simulate"] == pytest.approx(estimate.run_s(
+        scene, RATES, worst["method"], worst["precision"], substeps, scene.pendulums.count))
+    assert "quality" not in estimate.estimate(api.load("elastic_fan"), RATES).parts
+    assert estimate.estimate(api.load("elastic_fan", quality="reference"), RATES).parts["quality"] == 0
+
+
 def test_a_real_process_is_refused_within_5_s_of_cpu(tmp_path):
     """As a user runs it: Python's start, the imports and the plan take a few CPU seconds (the wall time on a
     loaded machine is the machine's, not the check's)."""
