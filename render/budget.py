@@ -37,6 +37,9 @@ from .keys import BUDGET_MAX
 DEFAULT_LIMIT_S = 3600.0  # "about one hour" (DESIGN.md, round 3); a scene's `budget` key or --budget raises it
 ANNOUNCE_S = 60.0  # a run estimated longer prints its estimate before it starts
 SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
+# The step cap of `pendulum lyapunov` (render/lyapunov.py), which is not costed in time yet: 1e11
+# pendulum-steps is about an hour of rigid f64 RK4 at estimate.RATES.
+STEP_LIMIT = 10 ** 11
 MEMORY_FRACTION = 0.8  # of physical memory: beyond it the machine swaps or the kernel kills the run
 DISK_FRACTION = 0.9  # of the free space: the rest is left for the system and the temporary files beside
 FALLBACK_MEMORY = 8 << 30  # where the physical memory cannot be read

@@ -5,7 +5,8 @@ Parts: `start` (Taichi's start, the kernels' compiles, ffmpeg's start), `simulat
 `certificate` (render/certify.py: the certified pendulums, up to 128, run again at the render's settings and
 by the shadow: RK4 at the same step, or an order-4 method at a quarter of it, in f64), `quality` (the pilot
 runs of --quality, render/quality.py), and `draw+encode` (per frame: a fixed cost, a cost per pixel, one per
-drawn link, the HUD; x264 and the GIF's ffmpeg per pixel of every frame), or `write` for `simulate`'s .npz.
+drawn link, the HUD; x264 per pixel of every frame, the GIF's ffmpeg of every frame it keeps), or `write`
+for `simulate`'s .npz.
 A comparison sums its panels (each variant simulated and certified, each panel drawn).
 
 Everything errs long: a --quality run is costed at the most expensive setting the pilots could choose, and
@@ -43,7 +44,7 @@ RATES = {
     #                        10^4 pendulums drew in 187, 348 and 800 ms a frame at 360, 720 and 1440 px
     "hud_frame_s": 8e-3,  # the HUD: +7.9 ms a frame (README, "What each effect costs")
     "mp4_frame_s": 3e-3, "mp4_pixel_s": 25e-9,  # x264: 16, 26 and 170 ms a frame at 360, 720 and 1440 px
-    "gif_frame_s": 2e-3, "gif_pixel_s": 8e-9,  # the GIF's ffmpeg (scales every frame): 6.5, 8.9 and 46 ms
+    "gif_frame_s": 2e-3, "gif_pixel_s": 8e-9,  # the GIF's ffmpeg, per frame piped to it: 6.5, 8.9 and 46 ms
     "npz_byte_s": 2e-8,  # savez_compressed: about 50 MB/s
 }
 REFERENCE_HEIGHT = 720  # px: draw_link_s is per link at this height
@@ -190,9 +191,10 @@ def picture_frame_s(scene, rates: dict, panels: int = 0) -> tuple[float, float]:
     links = scene.pendulums.count * len(cls.LINKS) if any(scene.has(e) for e in DRAWN) else 0
     links_s = sum(links * rates["draw_link_s"] * h / REFERENCE_HEIGHT for h in heights)
     per = rates["draw_frame_s"] + pixels * rates["draw_pixel_s"] + rates["hud_frame_s"] * scene.has("hud") + links_s
-    for fmt in ("mp4", "gif"):
+    # x264 sees every frame; the GIF's ffmpeg only those it keeps (render/encode.py), min(gif_fps, fps) a second
+    for fmt, share in (("mp4", 1.0), ("gif", min(v.gif_fps, v.fps) / v.fps)):
         if fmt in v.formats:
-            per += rates[f"{fmt}_frame_s"] + pixels * rates[f"{fmt}_pixel_s"]
+            per += share * (rates[f"{fmt}_frame_s"] + pixels * rates[f"{fmt}_pixel_s"])
     return per, links_s
 
 
