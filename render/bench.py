@@ -49,9 +49,9 @@ def add_parser(sub):
     p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal",
                        description="Measure simulation throughput (Taichi vs numpy), drawing and encoding fps, "
                                    "an end-to-end render against the encode-only floor, and the fractal maps; "
-                                   "write OUT/report.md, OUT/report.json and OUT/rates.json: this machine's rates, from "
-                                   "which `render --out DIR` estimates its run time when they are DIR/bench/rates.json "
-                                   "(the default out/bench serves the default out).")
+                                   "write OUT/report.md, OUT/report.json and OUT/rates.json: this machine's rates, "
+                                   "from which `render --out DIR` estimates its run time when they are "
+                                   "DIR/bench/rates.json (the default out/bench serves the default out).")
     p.add_argument("--quick", action="store_true", help="small N ladder and short videos (about 30 s)")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
