@@ -182,8 +182,8 @@ def test_watchdog_names_energy_drift(tmp_path):
                 "--set", "integrator.max_drift=1e-3", "--set", "integrator.min_faithful=0",
                 "--set", "integrator.allow_unstable=true", "--out", tmp_path, *SMALL)  # past the energy limit
     assert r.returncode == 1
-    assert "relative energy drift +" in r.stderr and "(gained)" in r.stderr and "integrator.max_drift" in r.stderr
-    assert "pendulum 0" in r.stderr
+    assert "relative energy drift" in r.stderr and "integrator.max_drift" in r.stderr and "pendulum 0" in r.stderr
+    assert "(lost)" in r.stderr  # symplectic Euler first loses here; which way it went is said (test_step_limit.py)
     assert not any(tmp_path.rglob("*"))
 
 
