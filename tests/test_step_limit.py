@@ -44,6 +44,7 @@ def run(scene):
     return sim
 
 
+@pytest.mark.slow  # 40 scenes, each compiles its kernels: about a minute per method
 @pytest.mark.parametrize("method", ["symplectic_euler", "rk2"])
 def test_095_of_the_stated_limit_runs_clean_from_random_chains(method):
     for system, pend in random_starts():
