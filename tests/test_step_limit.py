@@ -55,6 +55,32 @@ def test_095_of_the_stated_limit_runs_clean_from_random_chains(method):
         assert np.isfinite(sim.q.to_numpy()).all() and sim.drift[None] <= 0.05, (system, pend)
 
 
+@pytest.mark.parametrize("stiffness, damping", [(2e3, 0.0), (1e5, 0.0), (2e3, 5.0)])
+def test_rk2_on_springs_at_095_of_its_stated_limit_runs_clean(stiffness, damping):
+    """Symplectic Euler is symplectic on the springs' Cartesian coordinates (no energy limit); RK2 is not."""
+    pend = {"theta1": 2.0, "theta2": 2.6, "spread": 0.3, "stiffness": stiffness, "damping": damping}
+    base = make_scene("elastic", 4, pendulums=pend, integrator={"method": "rk2"}, video={"fps": 5, "duration": DURATION},
+                      effects=["energy"])
+    limit = stated_limit(base)
+    plan = registry.get("elastic")(base, allocate=False)
+    assert limit < integrators.stability_limit(base, plan.omega_max(*plan.initial_state()))  # the energy binds
+    assert plan.energy_limit(*plan.initial_state(), "symplectic_euler") == math.inf
+    sim = run(base.replace(integrator={"dt": 0.95 * limit}))
+    assert np.isfinite(sim.q.to_numpy()).all() and sim.drift[None] <= 0.05
+
+
+def test_the_energy_limit_is_measured_the_same_every_time():
+    from render import stability
+    system, pend = random_starts()[0]
+    scene = make_scene(system, 1, pendulums=pend, integrator={"method": "symplectic_euler"},
+                       video={"fps": 2, "duration": DURATION})
+    first = stated_limit(scene)
+    stability._memo.clear()
+    assert stated_limit(scene) == first
+    longer = scene.replace(video={"duration": 4 * DURATION})  # the drift grows with the duration, at most in
+    assert first / 4 <= stated_limit(longer) < first  # proportion: first order, at most a quarter of the step
+
+
 def test_a_pinned_dt_beyond_the_energy_limit_is_refused(tmp_path):
     r = run_cli("render", "classic", "--set", "integrator.method=symplectic_euler", "--set", "integrator.dt=0.01",
                 "--set", "video.width=64", "--set", "video.height=48", "--out", tmp_path, "--no-progress")
