@@ -136,6 +136,10 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
         plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)  # the step only
         ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads)
     main, sim = trajectory(scene, indices, arch, threads)
+    broken = ~(np.abs(main) < 1e30).all(-1)  # (frames, pendulums): NaN/inf, as the advance kernel flags them
+    if broken.any():  # a blow-up, not an untrue run: say so
+        frame, i = np.argwhere(broken)[0]
+        raise sim.blew_up(int(frame), frame / scene.video.fps, int(indices[i]), "NaN/inf")
     shadow = shadow_scene(scene, sim.h)
     if not shadow_first and shadow.integrator.method == scene.integrator.method:
         sim.restart()  # the same method in f64 at a quarter of the step: the same compiled kernel

@@ -11,6 +11,8 @@ import taichi as ti
 
 from .errors import SceneError
 
+DEFAULT_MAX_DRIFT = 0.05  # the energy watchdog's tolerance unless a scene sets integrator.max_drift
+
 # dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
 # implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
 # rk2's 2 is its limit on the real axis (a decaying mode: |1 + z + z²/2| <= 1 for z in [-2, 0]). On the
@@ -21,6 +23,17 @@ from .errors import SceneError
 STABILITY = {"symplectic_euler": 2.0, "verlet": 2.0, "rk2": 2.0, "rk4": 2.785, "yoshida4": 1.573,
              "implicit_midpoint": 1.0}
 ORDER = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 4, "implicit_midpoint": 2}
+# Where a method gains energy run-long, by the coordinates the system steps (its reference model): symplectic
+# Euler is symplectic on Cartesian springs (constant masses: v is a momentum up to them), not on a chain's
+# (θ, ω), whose mass matrix depends on θ; RK2 gains on every oscillation (|R(iy)|² = 1 + y⁴/4). There the step
+# must also keep the gain within max_drift over the run (render/stability.py's energy_limit). The others keep
+# energy bounded (Verlet and Yoshida on springs, the implicit midpoint stepping canonical (q, p) everywhere),
+# or only lose it at a stable step (RK4: |R(iy)| < 1 for y < 2.83), which leaves the stability bound's
+# premise, E ≤ E_max·(1 + max_drift), intact; the watchdog still stops a loss beyond max_drift.
+ENERGY_GAIN = {"symplectic_euler": ("chain",), "rk2": ("chain", "springs")}
+# On a linear oscillator a method that gains energy gains c·y^k of it per step (y = h·ω): (c, k). Springs are
+# linear in their stretch, so this bounds RK2's gain there from the fastest mode (stability.oscillator_limit).
+OSCILLATOR_GAIN = {"rk2": (0.25, 4)}
 SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
 AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
 
@@ -30,11 +43,21 @@ YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
 YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
 
 
-def step_limit(scene, omega_max: float) -> float:
-    """The longest stable step of the scene's method: its limit over the rate, damping added.
+def gains_energy(method: str, model: str) -> bool:
+    """Whether `method` gains energy run-long on a system of this reference model ("chain" | "springs")."""
+    return model in ENERGY_GAIN.get(method, ())
+
+
+def step_limit(scene, omega_max: float, energy_limit: float = math.inf) -> float:
+    """The longest step the scene's method is offered at: its stability limit over the rate, damping added,
+    and no longer than `energy_limit` (the step that keeps its energy gain within max_drift: System.energy_limit).
 
     Viscous damping c adds a decaying mode of rate c, which limits explicit methods on the real axis as an
     oscillation of rate ω does on the imaginary one; adding the two is a simple, safe bound."""
+    return min(stability_limit(scene, omega_max), energy_limit)
+
+
+def stability_limit(scene, omega_max: float) -> float:
     damping = scene.pendulums.damping if scene.has("damping") else 0.0
     rate = omega_max + damping
     if not math.isfinite(rate):
@@ -43,13 +66,21 @@ def step_limit(scene, omega_max: float) -> float:
     return STABILITY[scene.integrator.method] / rate if rate > 0 else math.inf  # at rest without gravity
 
 
-def timestep(scene, omega_max: float) -> tuple[float, int]:
+def timestep(scene, omega_max: float, energy_limit: float = math.inf) -> tuple[float, int]:
     """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
     frame_dt = 1.0 / scene.video.fps
     method, dt = scene.integrator.method, scene.integrator.dt
-    limit = step_limit(scene, omega_max)
+    limit = stability_limit(scene, omega_max)
     if dt == "auto":
-        dt = min(AUTO_DT, SAFETY * limit)
+        dt = min(AUTO_DT, SAFETY * limit, energy_limit)  # the energy limit is itself an accuracy bound
+    elif dt > energy_limit and dt <= limit and not scene.integrator.allow_unstable:
+        drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
+        raise SceneError(
+            f"{scene.source}: integrator.dt: {dt:g} s is beyond the energy limit of {method} for this scene: it is "
+            f"not symplectic on these coordinates, and pilot steps from the scene's hardest states say its energy "
+            f"could drift past integrator.max_drift = {drift:g} within the {scene.video.duration:g} s, "
+            f"so dt < {energy_limit:.3g} s; use integrator.dt = \"auto\", a smaller dt or a symplectic method, "
+            f"or set integrator.allow_unstable = true to proceed anyway")
     elif dt > limit and not scene.integrator.allow_unstable:
         damping = scene.pendulums.damping if scene.has("damping") else 0.0
         with_damping = f" + damping {damping:g} 1/s" if damping else ""

@@ -41,10 +41,11 @@ def cost(s: dict, fps: int) -> float:
     return EVALS[s["method"]] * steps * (0.5 if s["precision"] == "f32" else 1.0)
 
 
-def candidates(scene, rate: float) -> list[dict]:
-    """Every stable (method, dt, precision) the system offers, cheapest first."""
+def candidates(scene, rate: float, energy: dict) -> list[dict]:
+    """Every stable (method, dt, precision) the system offers, cheapest first; `energy` holds each method's
+    energy limit (System.energy_limit)."""
     frame = 1.0 / scene.video.fps
-    limit = {m: integrators.step_limit(_with(scene, setting(m, frame, "f64")), rate)
+    limit = {m: integrators.step_limit(_with(scene, setting(m, frame, "f64")), rate, energy[m])
              for m in registry.get(scene.system).METHODS}
     out = [setting(m, dt, p) for m in limit for p in ("f32", "f64")
            for dt in (frame, *(d for d in LADDER if d < frame)) if dt < limit[m]]
@@ -58,8 +59,9 @@ def choose(scene, arch: str = "cpu", threads=None):
         return scene, {"level": None, "chosen": _as_dict(scene.integrator), "why": "the preset's own settings"}
     cls = registry.get(scene.system)
     plan = cls(scene, allocate=False)
-    rate = plan.omega_max(*plan.initial_state())
-    cands = candidates(scene, rate)
+    q0, v0 = plan.initial_state()
+    rate = plan.omega_max(q0, v0)
+    cands = candidates(scene, rate, {m: plan.energy_limit(q0, v0, m) for m in cls.METHODS})
     if not cands:
         raise SceneError(f"{scene.source}: --quality {level}: no integrator is stable for this scene at the steps "
                          f"tried ({', '.join(f'{d:g}' for d in LADDER)} s)")

@@ -10,6 +10,8 @@ The integrators (render/integrators.py) call force(); the canvas reads only poin
 contract (LINKS, bob_sizes(), reach(), lengths).
 """
 
+import math
+
 import numpy as np
 import taichi as ti
 
@@ -17,7 +19,8 @@ from . import budget, grid, integrators, keys, poincare, runtime
 from .sincos import sincos
 from .errors import SimulationError
 
-DEFAULT_MAX_DRIFT = 0.05
+DEFAULT_MAX_DRIFT = integrators.DEFAULT_MAX_DRIFT  # the energy watchdog's tolerance unless a scene sets one
+BLOWN = 100.0  # a relative energy drift this large is a blow-up, not a drift
 
 
 class System(runtime.Launcher):
@@ -60,7 +63,8 @@ class System(runtime.Launcher):
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
         q0, v0 = self.initial_state()
-        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0))
+        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
+                                                     self.energy_limit(q0, v0, self.method))
         budget.check_steps(scene, self.substeps, self.h)  # "auto" is known only now: refuse before any work
         if subset is not None:
             q0, v0 = q0[subset], v0[subset]
@@ -115,6 +119,12 @@ class System(runtime.Launcher):
         initial states: the step limit is the method's limit over it plus the damping rate (integrators.timestep,
         render/stability.py)."""
         raise NotImplementedError
+
+    def energy_limit(self, q0: np.ndarray, v0: np.ndarray, method: str) -> float:
+        """The longest step (s) at which `method` keeps the energy gain of the whole run from these initial
+        states within integrator.max_drift, where it gains energy on this system (integrators.ENERGY_GAIN);
+        inf where it does not."""
+        return math.inf
 
     def deviation(self, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
         """How far apart two states are, per pendulum, in the unit of integrator.tolerance: rad on any angle."""
@@ -301,18 +311,26 @@ class System(runtime.Launcher):
     def check(self, frame: int, max_drift: float | None):
         """Watchdog, once per frame: NaN/inf anywhere, or energy drift beyond the tolerance."""
         bad = int(self.bad[None])
-        hint = "try a smaller integrator.dt, --quality high, or a symplectic method"
         if bad < self.n:
-            raise SimulationError(f"{self.scene.name}: frame {frame} (t={self.t:.4g} s): pendulum {bad} became "
-                                  f"NaN/inf ({self.method}, dt={self.h:.3g} s); {hint}")
+            raise self.blew_up(frame, self.t, bad, "NaN/inf")
         if max_drift is not None and self.scene.has("energy"):
             drift = float(self.drift[None])
             if drift > max_drift:
-                worst = int(np.argmax(np.abs(self.e.to_numpy() - self.e0.to_numpy()) / self.escale.to_numpy()))
+                d = (self.e.to_numpy() - self.e0.to_numpy()) / self.escale.to_numpy()
+                worst = int(np.argmax(d if self.damped else np.abs(d)))  # damped: only a gain is the error
+                if d[worst] >= BLOWN:
+                    raise self.blew_up(frame, self.t, worst, f"energy up {d[worst]:.3g}x its start's")
                 raise SimulationError(
                     f"{self.scene.name}: frame {frame} (t={self.t:.4g} s): pendulum {worst}: relative energy drift "
-                    f"{drift:.3g} exceeds integrator.max_drift = {max_drift:g} ({self.method}, dt={self.h:.3g} s); "
-                    f"{hint}")
+                    f"{100 * d[worst]:+.3g} % ({'gained' if d[worst] > 0 else 'lost'}) exceeds integrator.max_drift "
+                    f"= {max_drift:g} ({self.method}, dt={self.h:.3g} s); try a smaller integrator.dt, "
+                    f"--quality high, or a symplectic method")
+
+    def blew_up(self, frame: int, t: float, pendulum: int, what: str) -> SimulationError:
+        """The error of a run that blew up (the watchdog's, or the certificate's run: render/certify.py)."""
+        return SimulationError(f"{self.scene.name}: frame {frame} (t={t:.4g} s): blew up at t={t:.4g} s "
+                               f"(pendulum {pendulum}: {what}; {self.method}, dt={self.h:.3g} s); use a smaller "
+                               f"integrator.dt (\"auto\" keeps to the step limit)")
 
     def state(self) -> dict[str, np.ndarray]:
         """The arrays `simulate` writes for this frame, as STATE declares them."""

@@ -143,7 +143,8 @@ def test_simulate_errors_are_the_clis_typed_exceptions(tmp_path):
     with pytest.raises(SceneError, match="must end in .npz"):
         render.simulate(render.load("classic", **SMALL), out=tmp_path / "t.csv")
     untrue = render.load("classic", **{"integrator.method": "symplectic_euler", "pendulums.lengths": [1.0, 0.1],
-                                       "video.duration": 10})
+                                       "video.duration": 10, "integrator.allow_unstable": True})  # past its
+    # energy limit (render/stability.py): what this tests is the faithfulness watchdog
     with pytest.raises(SimulationError, match="min_faithful=0"):  # the faithfulness watchdog: exit 1 in the CLI
         render.simulate(untrue, out=tmp_path / "t.npz")
     assert not any(tmp_path.iterdir())

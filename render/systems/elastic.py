@@ -4,6 +4,7 @@ import math
 import numpy as np
 import taichi as ti
 
+from .. import stability
 from ..keys import Real
 from ..system import System
 
@@ -37,6 +38,9 @@ class Elastic(System):
         k1, k2, m1, m2 = self.k1, self.k2, self.m1, self.m2
         mk = np.array([[(k1 + k2) / m1, -k2 / m1], [-k2 / m2, k2 / m2]])
         return math.sqrt(max(np.linalg.eigvals(mk).real))
+
+    def energy_limit(self, q0, v0, method) -> float:
+        return stability.oscillator_limit(self.scene, self.omega_max(q0, v0), method)
 
     def deviation(self, qa, qb):
         """The farthest bob's distance apart, as a fraction of the total rest length."""

@@ -37,6 +37,9 @@ class Triple(System):
     def omega_max(self, q0, v0) -> float:
         return stability.chain_rate(self.scene, q0, v0)
 
+    def energy_limit(self, q0, v0, method) -> float:
+        return stability.energy_limit(self.scene, q0, v0, method, self.energy_floor())
+
     def initial_state(self):
         return self.initial_angles()
 
