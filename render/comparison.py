@@ -25,6 +25,7 @@ from .vary import VARIANTS, VARYING, vary_refusal
 EXAMPLES = """examples:
   pendulum compare rigid_chaos --vary integrator.precision=f32,f64
   pendulum compare rigid_chaos --vary integrator.method=symplectic_euler,rk2,rk4 --vary integrator.dt=2.5e-4,5e-4,1e-3
+    --set integrator.allow_unstable=true   # symplectic Euler's drift, shown on purpose: past its energy limit
   pendulum compare elastic_fan --vary pendulums.stiffness=2e3,2e4 --set video.duration=8
   pendulum compare compare_methods            # a preset's own [compare] table
 
