@@ -64,6 +64,9 @@ def check_render(scene_list, out: Path) -> None:
     out = Path(out)
     for scene in scene_list:
         check_out_folder(scene, out)
+        if scene.has("lyapunov"):  # an integrator with no tangent map, too few frames for the error
+            from . import lyapunov
+            lyapunov.check(scene, lyapunov.default_pendulums(scene))
         budget.check(scene, registry.get(scene.system), out)
 
 

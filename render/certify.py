@@ -40,6 +40,8 @@ class Certificate:
     until_s: np.ndarray  # per certified pendulum: the last frame time at which it was faithful
     duration: float
     cost_s: float
+    initial_error: np.ndarray  # per certified pendulum: |run − shadow|·MARGIN after the first frame (tolerance's unit)
+    lyapunov: dict | None = None  # with the "lyapunov" effect: λ1 and the horizon it predicts (render/lyapunov.py)
 
     @property
     def faithful_until_s(self) -> float:
@@ -68,6 +70,8 @@ class Certificate:
             counts, edges = np.histogram(self.until_s, bins=10, range=(0.0, self.duration))
             d["until_s_histogram"] = {"edges_s": [round(float(e), 4) for e in edges],
                                       "counts": [int(c) for c in counts]}
+        if self.lyapunov is not None:
+            d["lyapunov"] = self.lyapunov
         return d
 
     def line(self) -> str:
@@ -153,7 +157,7 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
     cls = registry.get(scene.system)
     cert = Certificate({"method": shadow.integrator.method, "dt": shadow.integrator.dt, "precision": "f64"}, tol,
                        "rad" if cls.ANGLES else "of the total length", indices, until, scene.video.duration,
-                       time.perf_counter() - t0)
+                       time.perf_counter() - t0, errors[min(1, len(errors) - 1)] * tol)
     check(scene, cert, sim.h)
     return cert
 

@@ -137,6 +137,10 @@ def physics(scene, rates: dict) -> tuple[dict, float, int]:
     _, shadow_substeps = pinned(scene, shadow.dt)
     parts["certificate"] = (run_s(scene, rates, i.method, i.precision, substeps, certified)
                             + run_s(scene, rates, shadow.method, "f64", shadow_substeps, certified))
+    if scene.has("lyapunov"):  # render/lyapunov.py: up to CAP of those, each with 2D tangent vectors, every frame
+        from .lyapunov import CAP, FRAME_S, TANGENT_COST
+        carried = min(CAP, certified) * (1 + 2 * plan.D * TANGENT_COST)
+        parts["lyapunov"] = run_s(scene, rates, i.method, "f64", substeps, carried) + scene.frames * FRAME_S
     return parts, h, substeps
 
 

@@ -30,6 +30,7 @@ round-off). The forward-mode kernel compiles in about 2 s (rigid) to 5 s (triple
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -45,6 +46,7 @@ MOST = 128  # pendulums --pendulums may name
 BLOCKS = 10
 Z = 2.0  # the error reported is Z standard errors
 TANGENT_COST = 3  # a dual step costs about this many primal steps (the steps budget counts them)
+FRAME_S = 5e-3  # the launches and QR of one frame, whatever the pendulums (measured 3-5 ms: see Cost above)
 
 
 def default_pendulums(scene) -> np.ndarray:
@@ -148,22 +150,37 @@ def summary(run: dict, damping: float) -> list[dict]:
 
 
 def horizons(scene, indices: np.ndarray, lam1: list[float], arch: str, threads) -> list[dict]:
-    """What λ1 predicts against what the certificate measures, per pendulum: the horizon ln(tol / e0)/λ1 from
-    the error e0 after the first frame (main run against the certificate's shadow, as certify measures it),
-    beside the certificate's faithful time. Errors are injected every step, not once, so it is a rough guide."""
-    cert = certify.certify(scene.replace(integrator={"min_faithful": 0.0}), arch, threads, indices)
-    main, sim = certify.trajectory(scene, indices, arch, threads, frames=2)
-    shadow, _ = certify.trajectory(certify.shadow_scene(scene, sim.h), indices, arch, threads, frames=2)
-    e0 = certify.MARGIN * sim.deviation(main[1], shadow[1])
-    tol = scene.integrator.tolerance
-    out = []
-    for k in range(len(indices)):
-        ok = lam1[k] > 0 and e0[k] > 0
-        out.append({"tolerance": tol, "unit": cert.unit, "initial_error": float(e0[k]),
-                    "predicted_horizon_s": float(math.log(tol / e0[k]) / lam1[k]) if ok else None,
+    """What λ1 predicts against what the certificate measures, for the pendulums `indices`."""
+    return predictions(certify.certify(scene.replace(integrator={"min_faithful": 0.0}), arch, threads, indices), lam1)
+
+
+def predictions(cert, lam1: list[float]) -> list[dict]:
+    """Per certified pendulum: the horizon ln(tol / e0)/λ1 from the error e0 after the first frame (run against
+    the certificate's shadow, as certify measures it), beside the certificate's faithful time. Errors are
+    injected every step, not once, so it is a rough guide."""
+    tol, out = cert.tolerance, []
+    for k, e0 in enumerate(cert.initial_error):
+        ok = lam1[k] > 0 and e0 > 0
+        out.append({"tolerance": tol, "unit": cert.unit, "initial_error": float(e0),
+                    "predicted_horizon_s": float(math.log(tol / e0) / lam1[k]) if ok else None,
                     "faithful_until_s": float(cert.until_s[k]),
-                    "faithful_through_the_end": bool(cert.until_s[k] >= scene.video.duration)})
+                    "faithful_through_the_end": bool(cert.until_s[k] >= cert.duration)})
     return out
+
+
+def for_certificate(scene, cert, arch: str = "cpu", threads=None) -> dict:
+    """metadata's faithfulness.lyapunov for a render with the "lyapunov" effect: λ1 of the certified pendulums
+    (thinned evenly to CAP) and the horizon it predicts, beside the faithful time the certificate measured."""
+    pick = certify.subsample(len(cert.indices), CAP)
+    indices = cert.indices[pick]
+    run = spectrum(scene, indices, arch, threads)
+    rows = summary(run, scene.pendulums.damping if scene.has("damping") else 0.0)
+    lam1 = [r["exponents"][0] for r in rows]
+    sub = dataclasses.replace(cert, indices=indices, until_s=cert.until_s[pick], initial_error=cert.initial_error[pick])
+    return {"unit": "1/s", "method": "Benettin, QR every frame, the exact tangent map (render/lyapunov.py)",
+            "cost_s": round(run["cost_s"], 3),
+            "pendulums": [{"pendulum": int(i), "lambda1": lam, "lambda1_error": r["errors"][0], **pred}
+                          for i, lam, r, pred in zip(indices, lam1, rows, predictions(sub, lam1))]}
 
 
 def measure(scene, indices: np.ndarray, arch: str = "cpu", threads=None, progress: bool = False):

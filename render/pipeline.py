@@ -1,6 +1,7 @@
 """Scene -> simulation -> canvas -> encoders: one render, and the draw-free `simulate`."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 import time
@@ -29,6 +30,11 @@ def prepare(scene, arch: str, threads: int | None):
     # A map certifies the lattice its trust mask is read from (render/grid.py), not 128 pixels in row order.
     cert = certify.certify(scene, arch, threads, grid.trust_indices(scene) if scene.fractal else None)
     timings = {"quality": t_quality, "certify": cert.cost_s} if scene.quality else {"certify": cert.cost_s}
+    if scene.has("lyapunov"):  # before the render's own runtime.init: the spectrum runs in f64
+        from . import lyapunov
+        t = time.perf_counter()
+        cert = dataclasses.replace(cert, lyapunov=lyapunov.for_certificate(scene, cert, arch, threads))
+        timings["lyapunov"] = time.perf_counter() - t
     return scene, chosen, cert, timings
 
 

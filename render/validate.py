@@ -33,7 +33,7 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
 }
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 # New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare")
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov")
 DRAWN = ("rods", "springs", "bobs", "trails")  # effects that draw the pendulums (glow composes these)
 PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/canvas.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
@@ -173,6 +173,9 @@ class Validator:
         effects = self.effects(d, system, pend, fractal)
         if "fractal" in effects and fractal is None:
             fractal = "angles"
+        if "lyapunov" in effects and (d.get("compare") is not None or fractal is not None):
+            self.fail("effects", "'lyapunov' measures the certified pendulums of one fan beside the certificate; "
+                      "for a comparison or a map, run `pendulum lyapunov` on the variant or pixel instead")
         if "poincare" in effects and d.get("compare") is not None:
             self.fail("compare", "a Poincaré section is drawn from crossings found as the pendulums are stepped, "
                       "which a comparison's panels do not record; render each variant with --set instead")

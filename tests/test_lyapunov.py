@@ -182,3 +182,35 @@ def test_help_explains_the_command():
     assert r.returncode == 0
     for word in ("Benettin", "lyapunov.json", "--pendulums", "canonical", "batch means"):
         assert word in r.stdout
+
+
+def test_a_render_with_the_lyapunov_effect_puts_lambda1_beside_its_certificate(tmp_path):
+    """effects += "lyapunov": metadata's faithfulness.lyapunov holds λ1 of the certified pendulums (thinned to
+    CAP), the same λ1 `pendulum lyapunov` measures for them, and the horizon it predicts from the certificate's
+    own first-frame error, beside the faithful time that certificate measured."""
+    from render import pipeline
+    small = ["video.width=128", "video.height=72", "video.fps=10", "video.duration=3", 'video.formats=["mp4"]',
+             'effects=["rods", "bobs", "energy", "lyapunov"]']
+    scene = load("rigid_chaos", small)
+    meta = pipeline.render(scene, tmp_path)
+    faith = meta["faithfulness"]
+    got = faith["lyapunov"]
+    picked = lyapunov.default_pendulums(scene)
+    assert [row["pendulum"] for row in got["pendulums"]] == picked.tolist() and got["unit"] == "1/s"
+    doc, _ = lyapunov.measure(scene, picked)  # the command's measurement of the same pendulums
+    for row, ref in zip(got["pendulums"], doc["pendulums"]):
+        assert row["lambda1"] == pytest.approx(ref["exponents"][0], rel=1e-12) and row["lambda1"] > 0
+        assert row["initial_error"] == pytest.approx(ref["faithfulness"]["initial_error"], rel=1e-12)
+        assert row["predicted_horizon_s"] == pytest.approx(np.log(1e-3 / row["initial_error"]) / row["lambda1"])
+        assert row["faithful_until_s"] == ref["faithfulness"]["faithful_until_s"]  # each pendulum's own, alone or not
+        assert faith["faithful_until_s"] <= row["faithful_until_s"]
+    assert meta["timings_s"]["lyapunov"] > 0
+
+
+def test_the_lyapunov_effect_is_refused_up_front_where_it_cannot_run(tmp_path):
+    r = run_cli("render", "classic", "--set", 'effects=["rods", "bobs", "lyapunov"]', "--set",
+                "integrator.method=implicit_midpoint", "--out", tmp_path / "out")
+    assert r.returncode == 2 and "integrator.method" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+    r = run_cli("render", "fractal_flip", "--set", 'effects=["fractal", "lyapunov"]', "--out", tmp_path / "out")
+    assert r.returncode == 2 and "'lyapunov'" in r.stderr and not (tmp_path / "out").exists()
