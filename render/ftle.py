@@ -59,8 +59,8 @@ class FtleMap(fractal.Map):
         self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
         self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
         self.twin = libm_twin(sim)
-        real, n = runtime.real(), 4 * self.pixels  # one kernel element per tangent vector of each pixel
-        D = 2 * sim.D
+        self.k = 2 * sim.D  # tangent vectors per pixel: the state's dimension (4 for the double pendulum)
+        real, n, D = runtime.real(), self.k * self.pixels, self.k  # one kernel element per tangent vector
         # dx: a zero offset to the state, whose duals are the columns of M; out: the frame's end and its duals
         self.dx = ti.Vector.field(D, real, shape=n, needs_dual=True)
         self.out = ti.Vector.field(D, real, shape=n, needs_dual=True)
@@ -113,8 +113,8 @@ class FtleMap(fractal.Map):
         return out
 
     def tangents(self) -> tuple[np.ndarray, np.ndarray]:
-        """(M, L): per pixel the 4×4 matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
-        m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, 4, -1).transpose(0, 2, 1)
+        """(M, L): per pixel the k×k matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
+        m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
         return m, self.log_scale.to_numpy().astype(np.float64)
 
     def summary(self) -> dict:
@@ -139,18 +139,18 @@ class FtleMap(fractal.Map):
 
     @ti.kernel
     def ftle_setup(self):
-        for e in range(4 * self.pixels):
-            self.dx[e] = ti.Vector.zero(float, 2 * self.sim.D)
-            self.dx.dual[e] = ti.Vector.unit(2 * self.sim.D, e % 4, float)
+        for e in range(self.k * self.pixels):
+            self.dx[e] = ti.Vector.zero(float, self.k)
+            self.dx.dual[e] = ti.Vector.unit(self.k, e % self.k, float)
         for p in range(self.pixels):
             self.log_scale[p], self.sigma[p] = 0.0, 0.0
 
     @ti.kernel
     def ftle_frame(self, sys: ti.template(), substeps: ti.i32, h: float):
-        """One frame of every pixel, four times: lane e % 4 with column e % 4 of its M as the state's dual."""
+        """One frame of every pixel, four times: lane e % k with column e % k of its M as the state's dual."""
         D = ti.static(self.sim.D)
-        for e in range(4 * self.pixels):
-            p, d = e // 4, self.dx[e]
+        for e in range(self.k * self.pixels):
+            p, d = e // self.k, self.dx[e]
             q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
             v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
             for _ in range(substeps):
@@ -160,17 +160,17 @@ class FtleMap(fractal.Map):
     @ti.kernel
     def ftle_renormalise(self):
         """The new state (lane 0's primal), M = the frame's images over their largest entry m, L += ln m."""
-        D = ti.static(self.sim.D)
+        D, K = ti.static(self.sim.D, self.k)
         for p in range(self.pixels):
             m = 0.0
-            for k in ti.static(range(4)):
-                m = ti.max(m, ti.abs(self.out.dual[4 * p + k]).max())
+            for k in ti.static(range(K)):
+                m = ti.max(m, ti.abs(self.out.dual[K * p + k]).max())
             ok = m > 0.0 and m < 1e30  # also NaN
             if ok:
-                for k in ti.static(range(4)):
-                    self.dx.dual[4 * p + k] = self.out.dual[4 * p + k] / m
+                for k in ti.static(range(K)):
+                    self.dx.dual[K * p + k] = self.out.dual[K * p + k] / m
                 self.log_scale[p] += ti.log(m)
-            x = self.out[4 * p]
+            x = self.out[K * p]
             self.sim.q[p] = ti.Vector([x[c] for c in ti.static(range(D))])
             self.sim.v[p] = ti.Vector([x[D + c] for c in ti.static(range(D))])
             if not (ok and ti.abs(x).max() < 1e30):
@@ -179,15 +179,15 @@ class FtleMap(fractal.Map):
     @ti.func
     def log_smax(self, p):
         """ln s_max(M) of pixel p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
-        cols = [self.dx.dual[4 * p + k] for k in ti.static(range(4))]
-        m = ti.Matrix.cols(cols)
+        K = ti.static(self.k)
+        m = ti.Matrix.cols([self.dx.dual[K * p + k] for k in ti.static(range(K))])
         b = m.transpose() @ m
         c = b
         for _ in range(SQUARINGS):
             c = c @ c
             c /= ti.abs(c).max()
-        best, x = 0.0, ti.Vector.zero(float, 4)
-        for k in ti.static(range(4)):
+        best, x = 0.0, ti.Vector.zero(float, K)
+        for k in ti.static(range(K)):
             n = c[:, k].norm_sqr()
             if n > best:
                 best, x = n, c[:, k]
