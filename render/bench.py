@@ -32,7 +32,7 @@ SIZE = ["video.width=1280", "video.height=720"]
 SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the first gives the headline figure
 # fractal_s: seconds of each map rendered (None: the preset's own). A flip map speeds up as pixels flip and
 # stop, so it is timed over its whole 20 s; the others cost about the same every frame, so 2 s tell (the FTLE
-# map, about twenty flip maps a frame, 1 s).
+# map, 10 to 20 times a plain advance per frame, 1 s).
 FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None, "peer_s": 10.0,
         "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": 2.0, "lyapunov": 1.0}}
 QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "min_s": 0.1, "rainbow_s": 3.0, "peer_s": 1.0,
