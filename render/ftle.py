@@ -38,8 +38,6 @@ frame at 720p, 17 substeps), far from video speed; a forward mode through a diff
 in the vectorised loop is the way to close that gap.
 """
 
-import math
-
 import numpy as np
 import taichi as ti
 
