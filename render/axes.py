@@ -16,7 +16,8 @@ BACKGROUND = (12, 12, 16)  # bytes: a near-black, so the map's own black ("canno
 INK = (0.86, 0.86, 0.86)  # text
 FRAME = (90, 90, 100)  # the plot's border and tick marks, bytes
 TITLE = {"angles": ("angles θ₁, θ₂ at time t", "angles"), "flip_time": ("flip time: first |θ₁| or |θ₂| > π", "flip time"),
-         "divergence": ("divergence time: when a twin ε away parts", "divergence")}  # long, short
+         "divergence": ("divergence time: when a twin ε away parts", "divergence"),
+         "lyapunov": ("FTLE σ = ln s_max(DΦ(t)) / t", "FTLE")}  # long, short
 
 
 @dataclasses.dataclass
@@ -47,6 +48,15 @@ def time_ticks(lo: float, hi: float, room: int) -> list[float]:
                  for m in mantissas if lo * (1 - 1e-9) <= m * 10.0 ** e <= hi * (1 + 1e-9)]
         if len(ticks) <= room:
             return ticks
+    return [lo, hi]
+
+
+def linear_ticks(lo: float, hi: float, room: int) -> list[float]:
+    """Ticks at a 1-2-5 step from lo to hi, the finest of which no more than `room` fit."""
+    for step in sorted(m * 10.0 ** e for e in range(-3, 4) for m in (1, 2, 5)):
+        ticks = [k * step for k in range(math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9) + 1)]
+        if len(ticks) <= room:
+            return [round(t, 12) for t in ticks]
     return [lo, hi]
 
 
@@ -108,12 +118,12 @@ def legend(d: Decor, scene, lay: grid.Layout, times: tuple[float, float], x: int
         y += 2 * ch + pad
     else:
         room = (lay.width - x - pad) // cw  # characters that fit in the legend's column
-        unit = "flip time [s]" if scene.fractal == "flip_time" else "time to part [s]"
+        unit = {"flip_time": "flip time [s]", "lyapunov": "σ [1/s]"}.get(scene.fractal, "time to part [s]")
         if scene.fractal == "divergence":  # two bars side by side: labels as long as they fit
             unit, apart = ("time to part [s]", "together: distance") if room >= 36 else ("t [s]", "|Δ|")
         d.texts.append((unit, x, y, small))
         y += ch + pad
-        bar(d, x, y, ch, bar_h, times, lay, "time")
+        bar(d, x, y, ch, bar_h, times, lay, "time", linear=scene.fractal == "lyapunov")
         if scene.fractal == "divergence":  # pairs still together: their distance, ε to the threshold
             bx = x + max(ch + 8 * cw, (len(unit) + 2) * cw)
             d.texts.append((apart, bx, y - ch - pad, small))
@@ -127,6 +137,8 @@ def legend(d: Decor, scene, lay: grid.Layout, times: tuple[float, float], x: int
     entries = [("untrusted: after faithful time", "untrusted", "untrusted")]
     if scene.fractal == "flip_time":
         entries = [("cannot flip (energy)", "never", "cannot flip"), ("not flipped yet", "pending", "not yet")] + entries
+    if scene.fractal == "lyapunov":
+        entries = [("energy barrier: no flip inside", "never", "barrier")] + entries
     room = (lay.width - x - ch - pad) // cw
     for text, what, short in entries:
         text = text if len(text) <= room else short
@@ -136,13 +148,15 @@ def legend(d: Decor, scene, lay: grid.Layout, times: tuple[float, float], x: int
         y += ch + pad
 
 
-def bar(d: Decor, x: int, y: int, w: int, h: int, times: tuple[float, float], lay: grid.Layout, what: str):
-    """A vertical log-time colour bar, early at the bottom, with tick labels on its right."""
+def bar(d: Decor, x: int, y: int, w: int, h: int, times: tuple[float, float], lay: grid.Layout, what: str,
+        linear: bool = False):
+    """A vertical colour bar, low at the bottom, log-scaled (times) or linear, with tick labels on its right."""
     lo, hi = times
     _, ch = lay.cell()
     d.swatches.append((x, y, w, h, what))
-    for t in time_ticks(lo, hi, max(2, h // (ch + 2))):
-        at = (math.log(t) - math.log(lo)) / (math.log(hi) - math.log(lo))
+    room = max(2, h // (ch + 2))
+    for t in (linear_ticks(lo, hi, room) if linear else time_ticks(lo, hi, room)):
+        at = (t - lo) / (hi - lo) if linear else (math.log(t) - math.log(lo)) / (math.log(hi) - math.log(lo))
         ty = y + h - 1 - round(at * (h - 1))
         d.rects.append((x + w, ty, lay.pad, 1, FRAME))
         d.texts.append((number(t), x + w + lay.pad + 2, ty, {"size": lay.font, "va": "middle"}))

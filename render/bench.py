@@ -26,14 +26,17 @@ from .errors import SimulationError
 from .options import check_writable
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
-FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fractal_divergence"}  # colouring: preset
+FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fractal_divergence",
+            "lyapunov": "fractal_lyapunov"}  # colouring: preset (each measured at 720p: SIZE)
+SIZE = ["video.width=1280", "video.height=720"]
 SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the first gives the headline figure
 # fractal_s: seconds of each map rendered (None: the preset's own). A flip map speeds up as pixels flip and
-# stop, so it is timed over its whole 20 s; the others cost about the same every frame, so 2 s tell.
+# stop, so it is timed over its whole 20 s; the others cost about the same every frame, so 2 s tell (the FTLE
+# map, 10 to 20 times a plain advance per frame, 1 s).
 FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None, "peer_s": 10.0,
-        "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": 2.0}}
+        "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": 2.0, "lyapunov": 1.0}}
 QUICK = {"ladder": [100, 10**4, 10**5], "chaos_s": 2.0, "min_s": 0.1, "rainbow_s": 3.0, "peer_s": 1.0,
-         "fractal_s": {"angles": 0.1, "flip_time": 0.1, "divergence": 0.1}}  # a smoke run: 6 frames each
+         "fractal_s": {"angles": 0.1, "flip_time": 0.1, "divergence": 0.1, "lyapunov": 0.1}}  # smoke: a few frames
 TARGETS = [("end_to_end_over_encode_floor", "<=", 1.3), ("sim_speedup_vs_numpy_1e5", ">=", 15.0),  # 10 in issue 8
            ("fractal_fps.flip_time", ">=", 5.0), ("fractal_peak_mem_mb", "<", 2048.0),  # issues 8 and 16
            ("rainbow_1000_draw_fps", ">=", 30.0),  # issue 14: 1000 glowing pendulums at 720p
@@ -258,7 +261,7 @@ def phase_fractal(colouring, cfg, arch, tmp) -> dict:
     render that compiles the same kernels; fps = frames / wall, the certificate included."""
     from .scene import load
     name, seconds = FRACTALS[colouring], cfg["fractal_s"][colouring]
-    scene = load(name, [f"video.duration={seconds}"] if seconds else [])
+    scene = load(name, SIZE + ([f"video.duration={seconds}"] if seconds else []))
     warm = load(name, ["video.width=256", "video.height=144", "video.duration=0.05"])
     wall, meta = timed_render(scene, arch, tmp, warm)
     return {"preset": name, "wall_s": wall, "frames": meta["frames"], "duration_s": scene.video.duration,
@@ -391,7 +394,8 @@ def markdown(r: dict) -> str:
                    f"{f['integrator']['precision']}", f"{f['map']['plot']['width']}²",
                    f"{f['wall_s']:.1f} s", f"**{f['fps']:.2f}**",
                    " / ".join(f"{f['timings'][k]:.1f}" for k in ("certify", "simulate", "draw", "encode")) + " s",
-                   f"{f['map']['events']} ({f['map']['events_trusted']})", f"{f['peak_mem_mb']:.0f}"]
+                   f"{f['map'].get('events', '–')} ({f['map'].get('events_trusted', f['map'].get('trusted'))})",
+                   f"{f['peak_mem_mb']:.0f}"]  # an FTLE map has no events: its trusted pixels
                   for c, f in r["fractal"].items()])
     rb = r["rainbow_1000"]
     out += ["", f"## rainbow_1000: 1000 pendulums, {', '.join(rb['effects'])}, {rb['size']}", ""]

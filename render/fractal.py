@@ -271,6 +271,11 @@ class Map(runtime.Launcher):
         return palette(1.0 - u)
 
     @ti.func
+    def bar_colour(self, u):
+        """The colour bar's colour at u in [0, 1] (bottom to top): time from lo to hi, log."""
+        return self.time_colour(ti.exp(self.log_lo + u * self.log_span))
+
+    @ti.func
     def together(self, d):
         """A pair's distance, ε to the threshold on a log scale, as a grey."""
         u = ti.log(ti.max(d, self.eps) / self.eps) / self.log_ratio
@@ -312,8 +317,8 @@ class Map(runtime.Launcher):
         for r, c in ti.ndrange(h, w):
             u = 1.0 - (r + 0.5) / h  # 0 at the bottom, 1 at the top
             col = ti.Vector([0.0, 0.0, 0.0])
-            if what == 0:  # time: the bar runs from lo (bottom) to hi, log
-                col = self.time_colour(ti.exp(self.log_lo + u * self.log_span))
+            if what == 0:  # the colour bar
+                col = self.bar_colour(u)
             elif what == 1:  # distance while together: ε (bottom) to the threshold
                 col = self.together(self.eps * ti.exp(u * self.log_ratio))
             elif what == 2:

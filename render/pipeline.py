@@ -88,7 +88,10 @@ class Source:
         self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
         self.sim = make_system(self.scene)
         if self.scene.fractal:
-            from .fractal import Map
+            if self.scene.fractal == "lyapunov":
+                from .ftle import FtleMap as Map  # it carries each pixel's tangent vectors through the frame
+            else:
+                from .fractal import Map
             self.canvas = Map(self.scene, self.sim, self.cert)  # it advances the pixels too: events per substep
         else:
             from .canvas import Canvas

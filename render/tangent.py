@@ -50,8 +50,14 @@ def check_method(scene):
                          f"{', '.join(m for m in registry.get(scene.system).METHODS if m not in UNSUPPORTED)})")
 
 
+def libm_twin(sim):
+    """The system's parameters with libm's sin/cos, which forward mode differentiates (no fields)."""
+    twin = sim.scene.replace(integrator={"trig": "libm"})
+    return registry.get(twin.system)(twin, subset=sim.subset, allocate=False)
+
+
 @contextlib.contextmanager
-def _scalarized():
+def scalarized():
     """Compile (and run) with matrices scalarised, which Taichi's forward mode needs for matrix locals."""
     cfg = ti.lang.impl.current_cfg()
     saved = cfg.force_scalarize_matrix
@@ -67,8 +73,7 @@ class TangentFlow:
     def __init__(self, sim):
         check_method(sim.scene)
         self.sim = sim
-        twin = sim.scene.replace(integrator={"trig": "libm"})
-        self.twin = registry.get(twin.system)(twin, subset=sim.subset, allocate=False)  # parameters only
+        self.twin = libm_twin(sim)
         self.D, self.k = sim.D, 2 * sim.D
         self.m = sim.n * self.k  # one kernel element per tangent vector of each pendulum
         # dx: the input's offset (dq, dp), 0, whose duals are the seeds; out: the frame's end (q, p)
@@ -100,6 +105,6 @@ class TangentFlow:
         seeds = basis.transpose(0, 2, 1).reshape(n * k, dim)  # element e = pendulum e // k, vector e % k
         self.dx.dual.from_numpy(seeds)
         self.out.dual.fill(0)  # forward mode adds into the output's duals
-        with _scalarized(), ti.ad.FwdMode(loss=self.loss, param=self.unit, seed=[1.0], clear_gradients=False):
+        with scalarized(), ti.ad.FwdMode(loss=self.loss, param=self.unit, seed=[1.0], clear_gradients=False):
             self.map_frame(self.twin, self.sim.substeps, self.sim.h)
         return self.out.dual.to_numpy().reshape(n, k, dim).transpose(0, 2, 1)

@@ -25,7 +25,7 @@ PRECISIONS = ("f32", "f64")
 TRIGS = ("inline", "libm")  # integrator.trig: render/sincos.py, or the C library's (bit for bit as the seed)
 FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
 LAYOUTS = ("fan", "grid", "shell")  # shell: on one energy shell, on the Poincaré section (render/poincare.py)
-FRACTALS = ("angles", "flip_time", "divergence")  # how a map (effects = ["fractal"]) colours its pixels
+FRACTALS = ("angles", "flip_time", "divergence", "lyapunov")  # how a map (effects = ["fractal"]) colours its pixels
 MAP_DEFAULTS = {  # [map]: fractal maps only
     "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
     "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
