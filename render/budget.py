@@ -12,7 +12,7 @@ Three estimates, each against a limit stated as a share of what this machine has
   state until it writes the file. Limit: MEMORY_FRACTION of the machine's physical memory;
 - output: bytes written (MP4 and GIF, or the .npz). Limit: DISK_FRACTION of the free space where they go.
 Counts are Python ints (64-bit and beyond, never a wrapped 32-bit counter); the substeps per frame must fit
-the advance kernel's i32 (SUBSTEP_LIMIT: beyond it the count wrapped to 0 and the video froze).
+the advance kernel's i32, which integrators.check_substeps refuses when the System settles its step.
 
 check() runs before any work (the CLI, compare and batch call check_run() for all their scenes before the
 first render). It plans the step the System settles on ("auto" depends on the physics) without building a
@@ -31,15 +31,11 @@ from pathlib import Path
 
 from .encode import QUEUE_FRAMES
 from .errors import SceneError
-from .integrators import AUTO_DT
+from .integrators import AUTO_DT, check_substeps
 from .keys import BUDGET_MAX
 
 DEFAULT_LIMIT_S = 3600.0  # "about one hour" (DESIGN.md, round 3); a scene's `budget` key or --budget raises it
 ANNOUNCE_S = 60.0  # a run estimated longer prints its estimate before it starts
-SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
-# The step cap of `pendulum lyapunov` (render/lyapunov.py), which is not costed in time yet: 1e11
-# pendulum-steps is about an hour of rigid f64 RK4 at estimate.RATES.
-STEP_LIMIT = 10 ** 11
 MEMORY_FRACTION = 0.8  # of physical memory: beyond it the machine swaps or the kernel kills the run
 DISK_FRACTION = 0.9  # of the free space: the rest is left for the system and the temporary files beside
 FALLBACK_MEMORY = 8 << 30  # where the physical memory cannot be read
@@ -77,7 +73,7 @@ def check(scene, system, out: Path | None, simulate: bool = False):
             per_frame = variant.video.fps * dt
             ratio = 1.0 / per_frame if per_frame > 0 else math.inf
             substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
-            check_steps(variant, substeps, 1.0 / (variant.video.fps * substeps))
+            check_substeps(variant, substeps, 1.0 / (variant.video.fps * substeps))
     rates, source = estimates.load_rates(out)
     est = _estimate(scene, json.dumps(rates, sort_keys=True), source, simulate)
     if est.total > limit_s(scene):
@@ -175,14 +171,6 @@ def duration(s: float) -> str:
         h, m = divmod(round(s / 60), 60)
         return f"{h} h {m} min" if m else f"{h} h"
     return f"{s / 3600:.3g} h"
-
-
-def check_steps(scene, substeps: int, h: float) -> None:
-    """Refuse substeps per frame beyond the kernel's i32 counter (the time budget refuses long runs)."""
-    if substeps <= SUBSTEP_LIMIT:
-        return
-    raise SceneError(f"{scene.source}: integrator.dt: dt too small: {substeps} substeps per frame of {h:.3g} s "
-                     f"exceed the step counter's limit of {SUBSTEP_LIMIT}; use a larger integrator.dt")
 
 
 def memory(scene, system, simulate: bool) -> tuple[int, str, str]:

@@ -124,7 +124,7 @@ def physics(scene, rates: dict) -> tuple[dict, float, int]:
     """({simulate, certificate[, quality]} seconds, step, substeps per frame) of one (non-comparison) scene."""
     plan = registry.get(scene.system)(scene, allocate=False)  # the stable step; refuses an unstable dt
     parts, (h, substeps) = {}, (plan.h, plan.substeps)
-    cands = quality.candidates(scene, plan.omega_max(*plan.initial_state())) if scene.quality else []
+    cands = quality.offered(scene, plan) if scene.quality else []
     if cands:  # (none: quality.choose refuses the scene)
         parts["quality"] = pilots_s(scene, cands, rates)
         worst = max(cands, key=lambda s: quality.cost(s, scene.video.fps))

@@ -66,6 +66,17 @@ def stability_limit(scene, omega_max: float) -> float:
     return STABILITY[scene.integrator.method] / rate if rate > 0 else math.inf  # at rest without gravity
 
 
+SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
+
+
+def check_substeps(scene, substeps: int, h: float) -> None:
+    """Refuse substeps per frame beyond the kernel's i32 counter: beyond it the count wrapped to 0 and the video
+    froze (render/budget.py refuses long runs by their time)."""
+    if substeps > SUBSTEP_LIMIT:
+        raise SceneError(f"{scene.source}: integrator.dt: dt too small: {substeps} substeps per frame of {h:.3g} s "
+                         f"exceed the step counter's limit of {SUBSTEP_LIMIT}; use a larger integrator.dt")
+
+
 def timestep(scene, omega_max: float, energy_limit: float = math.inf) -> tuple[float, int]:
     """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
     frame_dt = 1.0 / scene.video.fps

@@ -37,7 +37,7 @@ import time
 
 import numpy as np
 
-from . import budget, certify, grid, registry, runtime
+from . import certify, grid, registry, runtime
 from .errors import SceneError, SimulationError
 from .tangent import TangentFlow, check_method
 
@@ -46,6 +46,9 @@ MOST = 128  # pendulums --pendulums may name
 BLOCKS = 10
 Z = 2.0  # the error reported is Z standard errors
 TANGENT_COST = 3  # a dual step costs about this many primal steps (the steps budget counts them)
+# The command's cap, not costed in time yet (render/budget.py costs renders): 1e11 pendulum-steps is about an
+# hour of rigid f64 RK4 at estimate.RATES.
+STEP_LIMIT = 10 ** 11
 FRAME_S = 5e-3  # the launches and QR of one frame, whatever the pendulums (measured 3-5 ms: see Cost above)
 
 
@@ -80,10 +83,10 @@ def check(scene, indices: np.ndarray):
                          f"gives {scene.frames} frames; the spectrum's error needs at least {2 * BLOCKS + 1}")
     plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)
     steps = scene.frames * plan.substeps * len(indices) * (1 + 2 * plan.D * TANGENT_COST)
-    if steps > budget.STEP_LIMIT:
-        raise SceneError(f"{scene.source}: video.duration: the spectrum needs about {budget.num(steps)} "
+    if steps > STEP_LIMIT:
+        raise SceneError(f"{scene.source}: video.duration: the spectrum needs about {steps:.3g} "
                          f"pendulum-steps (tangent vectors included), beyond the budget of "
-                         f"{budget.num(budget.STEP_LIMIT)}; use fewer --pendulums or a shorter video.duration")
+                         f"{STEP_LIMIT:.0e}; use fewer --pendulums or a shorter video.duration")
 
 
 def error(rates: np.ndarray) -> np.ndarray:

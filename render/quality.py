@@ -41,6 +41,13 @@ def cost(s: dict, fps: int) -> float:
     return EVALS[s["method"]] * steps * (0.5 if s["precision"] == "f32" else 1.0)
 
 
+def offered(scene, plan) -> list[dict]:
+    """candidates() for the scene's planned System (allocate=False): its rate bound and each method's energy
+    limit, from its own initial states."""
+    q0, v0 = plan.initial_state()
+    return candidates(scene, plan.omega_max(q0, v0), {m: plan.energy_limit(q0, v0, m) for m in plan.METHODS})
+
+
 def candidates(scene, rate: float, energy: dict) -> list[dict]:
     """Every stable (method, dt, precision) the system offers, cheapest first; `energy` holds each method's
     energy limit (System.energy_limit)."""
@@ -59,9 +66,7 @@ def choose(scene, arch: str = "cpu", threads=None):
         return scene, {"level": None, "chosen": _as_dict(scene.integrator), "why": "the preset's own settings"}
     cls = registry.get(scene.system)
     plan = cls(scene, allocate=False)
-    q0, v0 = plan.initial_state()
-    rate = plan.omega_max(q0, v0)
-    cands = candidates(scene, rate, {m: plan.energy_limit(q0, v0, m) for m in cls.METHODS})
+    cands = offered(scene, plan)
     if not cands:
         raise SceneError(f"{scene.source}: --quality {level}: no integrator is stable for this scene at the steps "
                          f"tried ({', '.join(f'{d:g}' for d in LADDER)} s)")

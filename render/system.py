@@ -15,7 +15,7 @@ import math
 import numpy as np
 import taichi as ti
 
-from . import budget, grid, integrators, keys, poincare, runtime
+from . import grid, integrators, keys, poincare, runtime
 from .sincos import sincos
 from .errors import SimulationError
 
@@ -65,7 +65,7 @@ class System(runtime.Launcher):
         q0, v0 = self.initial_state()
         self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
                                                      self.energy_limit(q0, v0, self.method))
-        budget.check_steps(scene, self.substeps, self.h)  # "auto" is known only now: refuse before any work
+        integrators.check_substeps(scene, self.substeps, self.h)  # "auto" is known only now: before any work
         if subset is not None:
             q0, v0 = q0[subset], v0[subset]
         self.n, self.subset = len(q0), subset

@@ -141,7 +141,7 @@ def test_the_quality_pilots_count_and_the_costliest_choice_is_assumed():
     from render import quality
     scene = api.load("elastic_fan", quality="high")
     plan = registry.get(scene.system)(scene, allocate=False)
-    cands = quality.candidates(scene, plan.omega_max(*plan.initial_state()))
+    cands = quality.offered(scene, plan)
     worst = max(cands, key=lambda c: quality.cost(c, scene.video.fps))
     est = estimate.estimate(scene, RATES)
     ladders = {(c["method"], c["precision"]) for c in cands}

@@ -8,6 +8,7 @@ file outside, nested 100000 deep, of the wrong shape, with 10**400 in it, over t
 writer. The directory outside is snapshotted (listing, contents, mtimes, and atimes set older than mtimes, so
 that relatime records any read or listing) before and after the command.
 """
+import errno
 import hashlib
 import json
 import os
@@ -261,18 +262,27 @@ def test_the_sweeper_never_enters_a_symlinked_folder(tmp_path):
 
 @pytest.mark.parametrize("folder", ["/sys/kernel", "readonly"])
 def test_an_unwritable_gallery_folder_is_bad_input(tmp_path, folder):
+    """A folder no one may write: as root (CI), one made immutable (chattr +i), which stops root too."""
+    reason, pinned = os.strerror(errno.EACCES), False
     if folder == "readonly":
-        if os.geteuid() == 0:
-            pytest.skip("root writes into a read-only folder; /sys/kernel stands for it")
         folder = tmp_path / "readonly"
         folder.mkdir()
-        folder.chmod(0o555)
+        if os.geteuid() == 0:
+            made = subprocess.run(["chattr", "+i", str(folder)], capture_output=True, text=True)
+            assert made.returncode == 0, f"chattr +i (Debian: e2fsprogs): {made.stderr}"
+            reason, pinned = os.strerror(errno.EPERM), True
+        else:
+            folder.chmod(0o555)
     elif not os.path.isdir(folder):
         pytest.skip(f"no {folder} here")
-    r = run_cli("gallery", "--out", folder, timeout=TIMEOUT_S)
+    try:
+        r = run_cli("gallery", "--out", folder, timeout=TIMEOUT_S)
+    finally:
+        if pinned:
+            subprocess.run(["chattr", "-i", str(folder)], check=True)
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2 and len(lines) == 1, r.stderr
-    assert lines[0] == f"pendulum: error: --out {folder}: cannot write the gallery there: Permission denied"
+    assert lines[0] == f"pendulum: error: --out {folder}: cannot write the gallery there: {reason}"
 
 
 scalars = st.none() | st.booleans() | st.integers(-10**18, 10**18) | st.floats() | st.text(max_size=20)
