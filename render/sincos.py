@@ -16,8 +16,8 @@ f32 (their tails in f32, the leading terms in f64); the quadrant j mod 4 swaps a
 Both need IEEE arithmetic: Taichi's fast_math gives every float op LLVM's `reassoc nsz` flags, and LLVM may
 then fold the compensation terms away (x − j·P1 − j·P2 becomes x − j·(P1 + P2)). Whether it does depends on
 the CPU it compiles for: a fast_math-proof variant (the later parts multiplied by copies of j re-made from
-the integer quadrant) held on AVX2 but was 2.3e8 ulp off near k·π/2 on AVX-512, where the code generator
-proved the copies equal to j. So runtime.init starts Taichi with fast_math=False, and `sincos` refuses to
+the integer quadrant) held on AVX2 but was 2.3e8 ulp off near k·π/2 on AVX-512 (most likely its code
+generator proved the copies equal to j; AVX-512 code could not be inspected on the AVX2 machines here). So runtime.init starts Taichi with fast_math=False, and `sincos` refuses to
 compile under fast_math. (Measured on rigid RK4 at N = 1e5: fast_math off costs no measurable speed, since
 the advance loop still vectorises; `pendulum bench` reports the steps/s.) A reduction in f32 alone (π/2 in
 8 + 8 + 24 bits) was 30 % faster in the f32 kernel but up to 1e7 ulp wrong: not used. Cephes' polynomials
