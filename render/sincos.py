@@ -17,9 +17,11 @@ Both need IEEE arithmetic: Taichi's fast_math gives every float op LLVM's `reass
 then fold the compensation terms away (x − j·P1 − j·P2 becomes x − j·(P1 + P2)). Whether it does depends on
 the CPU it compiles for: a fast_math-proof variant (the later parts multiplied by copies of j re-made from
 the integer quadrant) held on AVX2 but was 2.3e8 ulp off near k·π/2 on AVX-512 (most likely its code
-generator proved the copies equal to j; AVX-512 code could not be inspected on the AVX2 machines here). So runtime.init starts Taichi with fast_math=False, and `sincos` refuses to
-compile under fast_math. (Measured on rigid RK4 at N = 1e5: fast_math off costs no measurable speed, since
-the advance loop still vectorises; `pendulum bench` reports the steps/s.) A reduction in f32 alone (π/2 in
+generator proved the copies equal to j; AVX-512 code could not be inspected on the AVX2 machines here).
+So runtime.init starts Taichi with fast_math=False, and `sincos` refuses to compile under fast_math.
+(Rigid RK4 at N = 1e5, fast_math off against on, interleaved on a loaded 2-core AVX2 machine: 4.8M against
+5.0-5.4M steps/s in f64, 8.8M against 8.5-9.1M in f32, within the noise; the advance loop still vectorises.
+`pendulum bench` reports the steps/s.) A reduction in f32 alone (π/2 in
 8 + 8 + 24 bits) was 30 % faster in the f32 kernel but up to 1e7 ulp wrong: not used. Cephes' polynomials
 wholly in f32 give 1.57 ulp, but an f32 flip map then parted from DOP853 where its trust mask vouched for it
 (tests/test_fractal.py): the f32 form here is as close to libm's sinf as the f64 leading terms make it.
