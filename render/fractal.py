@@ -102,6 +102,8 @@ def untrusted(c, x, y):
 class Map(runtime.Launcher):
     """The map of a grid scene: it advances the system (events per substep) and draws every frame."""
 
+    COLOUR = "fractal_colour"  # the kernel that colours the pixels; a subclass's map names its own
+
     def __init__(self, scene, sim, cert):
         v, self.scene, self.sim, self.kind = scene.video, scene, sim, scene.fractal
         self.lay = grid.layout(v.width, v.height)
@@ -144,7 +146,7 @@ class Map(runtime.Launcher):
         if out is None:
             out = self.new_frame()
         np.copyto(out, self.background)
-        self.launch("fractal_colour", out, self.sim.t)
+        self.launch(self.COLOUR, out, self.sim.t)
         if self.font:
             x, y = self.decor.clock
             self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")

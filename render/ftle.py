@@ -43,7 +43,7 @@ in the vectorised loop is the way to close that gap.
 import numpy as np
 import taichi as ti
 
-from . import axes, fractal, grid, integrators, runtime
+from . import fractal, grid, integrators, runtime
 from .font import Font
 from .tangent import check_method, libm_twin, scalarized
 
@@ -54,6 +54,8 @@ SQUARINGS = 10  # of MᵀM, for its top eigenvector
 @ti.data_oriented
 class FtleMap(fractal.Map):
     """The FTLE map of a grid scene: it carries each pixel's tangent vectors through every frame and draws σ_t."""
+
+    COLOUR = "ftle_colour"
 
     def __init__(self, scene, sim, cert):
         check_method(scene)
@@ -104,17 +106,6 @@ class FtleMap(fractal.Map):
             self.launch("ftle_frame", self.twin, sim.substeps, sim.h)
         self.launch("ftle_renormalise")
         sim.t += sim.substeps * sim.h
-
-    def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
-        """The map at the simulation's time (t, the canvas's clock argument, is the same and unused here)."""
-        if out is None:
-            out = self.new_frame()
-        np.copyto(out, self.background)
-        self.launch("ftle_colour", out, self.sim.t)
-        if self.font:
-            x, y = self.decor.clock
-            self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")
-        return out
 
     def tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """(M, L): per pixel the k×k matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
