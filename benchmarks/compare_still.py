@@ -15,8 +15,8 @@ sys.path.insert(0, str(ROOT))
 
 from PIL import Image  # noqa: E402  (here only, for the palette: renders never need Pillow)
 
-from render import pipeline  # noqa: E402
-from render.scene import load  # noqa: E402
+from render.video import pipeline  # noqa: E402
+from render.config.scene import load  # noqa: E402
 
 
 def main() -> int:

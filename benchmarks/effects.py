@@ -21,9 +21,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from render import pipeline, runtime  # noqa: E402
-from render.canvas import Canvas  # noqa: E402
-from render.scene import load  # noqa: E402
+from render.video import pipeline
+from render.physics import runtime  # noqa: E402
+from render.draw.canvas import Canvas  # noqa: E402
+from render.config.scene import load  # noqa: E402
 
 LADDERS = {
     "rigid_chaos": [["energy"], ["bobs"], ["bobs", "rods"], ["bobs", "rods", "trails"],

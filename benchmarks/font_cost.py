@@ -1,4 +1,4 @@
-"""Per-call cost of render/font.py on a 1280×720 frame: microseconds per draw call, best of 5 rounds.
+"""Per-call cost of render/draw/font.py on a 1280×720 frame: microseconds per draw call, best of 5 rounds.
 
     python benchmarks/font_cost.py [--threads N]
 
@@ -17,7 +17,7 @@ os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
 import numpy as np  # noqa: E402
 import taichi as ti  # noqa: E402
 
-from render import runtime  # noqa: E402
+from render.physics import runtime  # noqa: E402
 
 
 def best_us(fn, calls=200, rounds=5):
@@ -36,7 +36,7 @@ def main():
     ap.add_argument("--threads", type=int, default=None)
     args = ap.parse_args()
     runtime.init("cpu", "f64", args.threads)
-    from render.font import Font
+    from render.draw.font import Font
 
     font = Font("10x20")
     frame = np.zeros((720, 1280, 3), np.uint8)

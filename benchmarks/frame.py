@@ -19,9 +19,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from PIL import Image  # noqa: E402
 
-from render import pipeline  # noqa: E402
-from render.atomic import write_atomic  # noqa: E402
-from render.scene import load  # noqa: E402
+from render.video import pipeline  # noqa: E402
+from render.video.atomic import write_atomic  # noqa: E402
+from render.config.scene import load  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -4,7 +4,7 @@
 
 Each row is `pendulum simulate` of a preset (the seed's values, as it ran them) or of the same preset with
 another integrator, and the faithfulness certificate of that run. "Same cost" counts force evaluations per
-simulated second, f32 at half weight, as --quality does (render/quality.py: cost()).
+simulated second, f32 at half weight, as --quality does (render/trust/quality.py: cost()).
 """
 import argparse
 import sys
@@ -15,9 +15,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from render import pipeline  # noqa: E402
-from render.quality import cost  # noqa: E402
-from render.scene import load  # noqa: E402
+from render.video import pipeline  # noqa: E402
+from render.trust.quality import cost  # noqa: E402
+from render.config.scene import load  # noqa: E402
 
 ROWS = [  # (preset, overrides, what the row is)
     ("seed_rigid", [], "the talk's rigid fan: symplectic Euler, f32, dt 1e-4 (100 steps per 0.01 s frame)"),

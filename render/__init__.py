@@ -1,6 +1,6 @@
 """pendulum: double-pendulum presets to MP4 and GIF, simulated and drawn with Taichi.
 
-The Python API (render/api.py, results in render/results.py):
+The Python API (render/commands/api.py, results in render/commands/results.py):
 
     import render
     scene = render.load("classic", **{"video.duration": 2})   # the frozen, validated Scene
@@ -12,7 +12,7 @@ Errors are the typed exceptions of render/errors.py: SceneError (bad input), Sim
 """
 import os
 
-from .version import __version__  # noqa: F401
+from .video.version import __version__  # noqa: F401
 
 # Before any module imports taichi: no network version check, no banner on stdout.
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
@@ -26,13 +26,13 @@ __all__ = ["load", "render", "simulate", "compare", "RenderResult", "Trajectory"
 
 def __getattr__(name):
     if name in ("load", "render", "simulate", "compare"):
-        from . import api
+        from .commands import api
         value = getattr(api, name)
     elif name in ("RenderResult", "Trajectory"):
-        from . import results
+        from .commands import results
         value = getattr(results, name)
     elif name == "Scene":
-        from .scene import Scene as value
+        from .config.scene import Scene as value
     elif name in ("SceneError", "SimulationError", "EncodeError"):
         from . import errors
         value = getattr(errors, name)

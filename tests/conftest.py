@@ -43,7 +43,7 @@ def update_goldens(request):
 
 def make_scene(system="rigid", count=1, **sections):
     """A Scene from keyword sections, e.g. make_scene(pendulums={"theta1": 1.0}, video={"fps": 50})."""
-    from render.scene import from_dict
+    from render.config.scene import from_dict
     raw = {"system": system, "pendulums": {"count": count}}
     for key, val in sections.items():
         if isinstance(val, dict):
@@ -74,14 +74,14 @@ PICKS = {"first": 0, "early": 5, "later": 29}  # t = 0, 0.5 s, 2.9 s: well befor
 
 
 def small_scene(name):
-    from render.scene import load
+    from render.config.scene import load
     return load(name, [f"video.width={SMALL_W}", f"video.height={SMALL_H}", f"video.fps={SMALL_FPS}",
                        f"video.duration={SMALL_SECONDS}", 'video.formats=["mp4", "gif"]'])
 
 
 def render_small(name, out, threads=None):
     """(folder, metadata, raw frames at PICKS) of the small render of preset `name` into OUT."""
-    from render import pipeline
+    from render.video import pipeline
     scene, frames, want = small_scene(name), {}, {v: k for k, v in PICKS.items()}
     meta = pipeline.render(scene, out, threads=threads,
                            frame_hook=lambda f, fr: frames.__setitem__(want[f], fr.copy()) if f in want else None)
@@ -90,8 +90,8 @@ def render_small(name, out, threads=None):
 
 @pytest.fixture(scope="session")
 def preset_renders(tmp_path_factory):
-    from render import split
-    from render.scene import list_presets
+    from render.draw import split
+    from render.config.scene import list_presets
     out = tmp_path_factory.mktemp("presets")
     with pytest.MonkeyPatch.context() as mp:
         # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.

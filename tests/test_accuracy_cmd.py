@@ -5,9 +5,9 @@ import imageio.v3 as iio
 import numpy as np
 
 from conftest import run_cli
-from render import registry
-from render.accuracy import COLUMNS
-from render.scene import METHODS
+from render.physics import registry
+from render.commands.accuracy import COLUMNS
+from render.config.scene import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_precision", "energy_drift")),

@@ -1,4 +1,4 @@
-"""The Python API (render/api.py): load's overrides, render's and simulate's results, their errors, and how
+"""The Python API (render/commands/api.py): load's overrides, render's and simulate's results, their errors, and how
 the results display in a notebook (_repr_html_)."""
 import base64
 import html.parser
@@ -107,7 +107,7 @@ def test_a_gif_only_render_embeds_the_gif_when_small(tmp_path, monkeypatch):
     [(tag, src)] = media_of(result._repr_html_())
     assert tag == "img" and src.startswith("data:image/gif;base64,")
     assert base64.b64decode(src.split(",", 1)[1]) == result.paths["gif"].read_bytes()
-    monkeypatch.setattr("render.results.EMBED_BYTES", 10)  # a large GIF is linked, not embedded
+    monkeypatch.setattr("render.commands.results.EMBED_BYTES", 10)  # a large GIF is linked, not embedded
     [(tag, src)] = media_of(result._repr_html_())
     assert tag == "img" and src == "o/classic/classic.gif" and Path(src).is_file()
 
@@ -144,7 +144,7 @@ def test_simulate_errors_are_the_clis_typed_exceptions(tmp_path):
         render.simulate(render.load("classic", **SMALL), out=tmp_path / "t.csv")
     untrue = render.load("classic", **{"integrator.method": "symplectic_euler", "pendulums.lengths": [1.0, 0.1],
                                        "video.duration": 10, "integrator.allow_unstable": True})  # past its
-    # energy limit (render/stability.py): what this tests is the faithfulness watchdog
+    # energy limit (render/physics/stability.py): what this tests is the faithfulness watchdog
     with pytest.raises(SimulationError, match="min_faithful=0"):  # the faithfulness watchdog: exit 1 in the CLI
         render.simulate(untrue, out=tmp_path / "t.npz")
     assert not any(tmp_path.iterdir())
@@ -180,8 +180,8 @@ def no_pipeline(monkeypatch):
         seen.append((scene, kwargs))
         raise Ran()
 
-    monkeypatch.setattr(render.api.pipeline, "render", stand_in)
-    monkeypatch.setattr(render.api.pipeline, "simulate", stand_in)
+    monkeypatch.setattr(render.commands.api.pipeline, "render", stand_in)
+    monkeypatch.setattr(render.commands.api.pipeline, "simulate", stand_in)
     return seen
 
 

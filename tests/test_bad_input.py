@@ -2,7 +2,7 @@
 import pytest
 
 from conftest import run_cli
-from render import cli
+from render.commands import cli
 
 GOOD = """\
 system = "rigid"

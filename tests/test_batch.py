@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from render import batch, gallery
-from render.cli import main
+from render.commands import batch, gallery
+from render.commands.cli import main
 
 PRESET = """description = "{desc}"
 system = "{system}"

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from render import peers, pipeline
-from render.scene import load
+from render.commands import peers
+from render.video import pipeline
+from render.config.scene import load
 
 KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_peak_mem_mb",
         "rainbow_1000_draw_fps", "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
@@ -57,7 +58,7 @@ def small_fractal(w=64, h=36, seconds=0.2):
 
 
 def test_fractal_preset_is_a_720p_grid_without_trails_or_rods():
-    from render import grid
+    from render.physics import grid
     s = load("fractal")
     lay = grid.layout(1280, 720)
     assert (s.video.width, s.video.height, s.pendulums.count) == (1280, 720, lay.pixels)
@@ -96,7 +97,7 @@ def test_fractal_frames_do_not_depend_on_thread_count(tmp_path):
 
 def test_serial_and_parallel_drawing_give_the_same_bytes(tmp_path):
     """Few CPU threads draw serially with a plain max; more threads (and CUDA) use atomic max in parallel."""
-    from render.canvas import SERIAL_MAX_THREADS
+    from render.draw.canvas import SERIAL_MAX_THREADS
     assert SERIAL_MAX_THREADS < 8
     scene = load("rigid_chaos", ["video.width=320", "video.height=180", "video.duration=1", 'video.formats=["mp4"]'])
     runs = []

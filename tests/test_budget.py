@@ -1,4 +1,4 @@
-"""The up-front budget (render/budget.py, render/estimate.py): each estimate, its limit, and what the refusal
+"""The up-front budget (render/config/budget.py, render/config/estimate.py): each estimate, its limit, and what the refusal
 says. The run-time refusals run as a user runs them (cli.main in this process) and must come within 5 s
 with nothing simulated, no kernel compiled and nothing written."""
 import contextlib
@@ -14,7 +14,10 @@ from pathlib import Path
 import pytest
 
 from conftest import make_scene, run_cli
-from render import api, budget, cli, comparison, estimate, keys, pipeline, registry, runtime
+from render.commands import api, cli, comparison
+from render.config import budget, estimate
+from render.physics import keys, registry, runtime
+from render.video import pipeline
 from render.errors import SceneError
 
 SMALL = {"width": 64, "height": 48, "fps": 10, "duration": 1.0}
@@ -117,7 +120,7 @@ def test_a_comparison_counts_the_sum_of_its_panels(tmp_path):
                  "draw+encode")
     scene = comparison.with_table(api.load("rigid_chaos", "pendulums.count=100000", "video.duration=10"),
                                   {"integrator.dt": [1e-3, 5e-4, 2.5e-4, 2e-3]})
-    from render.split import layout
+    from render.draw.split import layout
     _, _, w, h = layout(scene.video.width, scene.video.height, 4)[0]
     for variant in scene.variants():
         check(variant.replace(video={"width": w, "height": h}), out=tmp_path)  # within the limit alone
@@ -138,7 +141,7 @@ def test_stiff_light_springs_are_refused_by_the_time_they_take(tmp_path):
 def test_the_quality_pilots_count_and_the_costliest_choice_is_assumed():
     """--quality: the pilots (a reference and a bisection per method and precision, each a kernel to compile),
     and the render at the most expensive setting the pilots could choose."""
-    from render import quality
+    from render.trust import quality
     scene = api.load("elastic_fan", quality="high")
     plan = registry.get(scene.system)(scene, allocate=False)
     cands = quality.offered(scene, plan)
@@ -281,7 +284,7 @@ def test_a_malformed_rates_file_is_ignored(tmp_path, text):
 
 def test_benchs_rates_reproduce_what_it_measured(tmp_path):
     """The rates `pendulum bench` writes (estimate.measured, from its phases' results), read back by a render."""
-    from render import bench
+    from render.commands import bench
     chaos = bench.chaos_scene(bench.QUICK)
     rows = [{"system": s, "precision": p, "n": n, "taichi": rate * (1 + n / 1e6)}
             for (s, p), rate in {("rigid", "f64"): 3e7, ("rigid", "f32"): 5e7, ("elastic", "f64"): 9e7,

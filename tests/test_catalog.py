@@ -1,9 +1,9 @@
 """Where presets are found: $PENDULUM_PRESETS, then ./presets/, then the shipped ones; first match wins."""
 import pytest
 
-from render import catalog
+from render.config import catalog
 from render.errors import SceneError
-from render.scene import load
+from render.config.scene import load
 
 MINE = 'description = "{what}"\nsystem = "{system}"\n[pendulums]\ncount = 2\n'
 

@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 
 from conftest import make_scene, out_folder, run_cli
-from render import certify, pipeline, quality, reference, runtime
-from render.scene import load
+from render.trust import certify, quality
+from render.video import pipeline
+from render.physics import reference, runtime
+from render.config.scene import load
 
 
 def reference_until(scene, indices):
@@ -107,7 +109,7 @@ def test_the_step_limit_refuses_up_front_what_would_blow_up(tmp_path, case):
 
 
 def limit_of(scene) -> float:
-    from render.integrators import step_limit
+    from render.physics.integrators import step_limit
     plan = pipeline.registry.get(scene.system)(scene, allocate=False)
     q0, v0 = plan.initial_state()
     return step_limit(scene, plan.omega_max(q0, v0), plan.energy_limit(q0, v0, scene.integrator.method))

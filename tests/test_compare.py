@@ -12,8 +12,10 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from render import batch, cli, pipeline, split
-from render.scene import load
+from render.commands import batch, cli
+from render.video import pipeline
+from render.draw import split
+from render.config.scene import load
 
 # rigid_chaos as shipped, but small and short enough for a test: the fan still parts under f32 by 9 s.
 SMALL_VIDEO = "[video]\nwidth = 320\nheight = 180\nfps = 15\nduration = 9.0\nformats = [\"mp4\", \"gif\"]\n"

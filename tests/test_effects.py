@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from render import pipeline, runtime
+from render.video import pipeline
+from render.physics import runtime
 
 VIDEO = {"width": 160, "height": 90, "fps": 10, "duration": 0.5}
 PEND = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
@@ -83,7 +84,7 @@ def test_damping_is_simulated_only_when_called_for(tmp_path):
 @pytest.mark.parametrize("effects", [["springs"], ["fractal"], ["rods", "fractal"], ["fractal", "hud"],
                                      ["fractal", "glow"]])
 def test_invalid_combinations_are_bad_input(effects):
-    from render.scene import SceneError
+    from render.config.scene import SceneError
     with pytest.raises(SceneError, match="effects"):
         make_scene("rigid", 2, effects=effects, pendulums=PEND, video=VIDEO)
 
@@ -107,6 +108,6 @@ def test_the_hud_is_only_paid_for_when_asked_and_only_adds_light(tmp_path):
 
 @pytest.mark.parametrize("effects", [["glow"], ["energy", "glow"]])
 def test_glow_without_anything_drawn_is_bad_input(effects):
-    from render.scene import SceneError
+    from render.config.scene import SceneError
     with pytest.raises(SceneError, match="effects: 'glow'"):
         make_scene("rigid", 2, effects=effects, pendulums=PEND, video=VIDEO)

@@ -1,4 +1,4 @@
-"""render/encode.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps filter picked them."""
+"""render/video/encode.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps filter picked them."""
 import itertools
 import subprocess
 import types
@@ -7,7 +7,7 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 
-from render import encode
+from render.video import encode
 
 EXE = imageio_ffmpeg.get_ffmpeg_exe()
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from render import font_data, runtime
+from render.draw import font_data
+from render.physics import runtime
 
 GOLDEN = Path(__file__).parent / "golden_text" / "hud.png"  # not a preset: apart from tests/golden/
 
@@ -52,7 +53,7 @@ def art(s):
 @pytest.fixture(scope="module")
 def font():
     runtime.init("cpu", "f64")
-    from render.font import Font
+    from render.draw.font import Font
     return Font("6x13")
 
 
@@ -89,7 +90,7 @@ def test_colour_bytes_and_whole_number_scale(small):
 
 
 def test_every_label_character_of_the_brief_is_in_both_sizes(font):
-    from render.font import SIZES, has_glyph
+    from render.draw.font import SIZES, has_glyph
     wanted = "t=12.34srk4dt1e-3f64θωπΔεΘΩ±×·°µ≤≥−→√∞≈²₁₂⁻"
     for ch in wanted:
         assert has_glyph(ch), ch
@@ -102,7 +103,7 @@ def test_every_label_character_of_the_brief_is_in_both_sizes(font):
 
 
 def test_unknown_characters_fall_back(small):
-    from render.font import text_width
+    from render.draw.font import text_width
     question = small.draw(blank(), "?", 0, 0)
     for ch in ("中", "\x07", "🙂"):
         np.testing.assert_array_equal(small.draw(blank(), ch, 0, 0), question, err_msg=repr(ch))
@@ -114,7 +115,7 @@ def test_unknown_characters_fall_back(small):
 
 
 def test_text_width_and_alignment(font):
-    from render.font import text_height, text_width
+    from render.draw.font import text_height, text_width
     assert text_width("t = 12.34 s") == 66 and text_width("t = 12.34 s", 2) == 132
     assert text_width("t = 12.34 s", size="10x20") == 110
     assert text_width("ab\nlonger\nc") == 36 and text_height("ab\nlonger\nc", 2) == 78
@@ -162,7 +163,7 @@ def test_blends_on_a_background(small):
 
 def test_field_target_marks_tiles_and_matches_the_byte_path(small):
     import taichi as ti
-    from render.font import TILE
+    from render.draw.font import TILE
     h, w = 32, 48
     field = ti.Vector.field(3, ti.f32, (h, w))
     tiles = ti.field(ti.i32, (h // TILE, w // TILE))
@@ -220,11 +221,11 @@ def test_hud_matches_its_golden_and_is_deterministic(font, update_goldens):
 SCRIPT = """
 import hashlib, sys
 sys.path.insert(0, {tests!r})
-from render import runtime
+from render.physics import runtime
 from test_font import hud
 for precision, threads in (("f64", 1), ("f32", 2)):
     runtime.init("cpu", precision, threads)
-    from render.font import Font
+    from render.draw.font import Font
     print(hashlib.sha256(hud(Font("6x13")).tobytes()).hexdigest())
 """
 

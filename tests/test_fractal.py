@@ -7,8 +7,12 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from render import axes, certify, fractal, grid, pipeline, reference
-from render.scene import load
+from render.draw import axes
+from render.trust import certify
+from render.maps import fractal
+from render.physics import grid, reference
+from render.video import pipeline
+from render.config.scene import load
 
 G = 9.8
 

@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
-from render import pipeline, registry, runtime
-from render.scene import load
+from render.video import pipeline
+from render.physics import registry, runtime
+from render.config.scene import load
 
 W, H, FPS = 256, 144, 30
 
@@ -12,7 +13,7 @@ def bob_pixels_over_the_run(name, *sets):
     """Every bob's pixel position (the canvas's own transform) at every frame of the whole run."""
     scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", 'effects=["bobs"]', *sets])
     runtime.init("cpu", scene.integrator.precision)
-    from render.canvas import Canvas
+    from render.draw.canvas import Canvas
 
     sim = pipeline.make_system(scene)
     canvas = Canvas(scene, sim)

@@ -9,8 +9,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from conftest import run_cli
-from render import axes, fractal, ftle, grid, pipeline, reference
-from render.scene import load
+from render.draw import axes
+from render.maps import fractal, ftle
+from render.physics import grid, reference
+from render.video import pipeline
+from render.config.scene import load
 
 
 def run_map(scene, threads=None):
@@ -26,7 +29,7 @@ def small(n=24, seconds=4.0, *sets):
 
 def variational_sigma(scene, q0, v0, t_end):
     """σ_t = ln s_max(DΦ(t)) / t at t_end from each start, in (θ1, θ2, ω1, ω2), by DOP853 on the state and
-    its variational equations δ' = J·δ (Φ(0) = I), J from central differences of render/reference.py's
+    its variational equations δ' = J·δ (Φ(0) = I), J from central differences of render/physics/reference.py's
     independent chain model (the mass-matrix form, not the Taichi system's closed form)."""
     n, d = q0.shape
     eps = 1e-6

@@ -23,9 +23,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import out_folder, run_cli
-from render import batch, budget, cli, estimate, pipeline, registry, runtime
+from render.commands import batch, cli
+from render.config import budget, estimate
+from render.video import pipeline
+from render.physics import registry, runtime
 from render.errors import SceneError
-from render.scene import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SCHEMA, SYSTEMS
+from render.config.scene import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SCHEMA, SYSTEMS
 
 BASE = {"system": SYSTEMS[0], "pendulums": {"count": 2, "theta1": 2.0, "theta2": 2.5},
         "video": {"width": 16, "height": 16, "fps": 10, "duration": 0.2, "gif_width": 16}}

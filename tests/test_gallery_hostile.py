@@ -22,9 +22,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import run_cli
-from render import atomic, confined, gallery
-from render.scene import load
-from render.version import __version__
+from render.video import atomic
+from render.commands import confined, gallery
+from render.config.scene import load
+from render.video.version import __version__
 
 TIMEOUT_S = 30  # about 3 s here; the FIFO hung for ever and /dev/zero read until memory ran out
 SKIPPED = {  # folder -> what its card says after "skipped: "

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from conftest import make_scene, run_cli
-from render import glow, pipeline
-from render.scene import load
+from render.draw import glow
+from render.video import pipeline
+from render.config.scene import load
 
 VIDEO = {"width": 160, "height": 90, "fps": 10, "duration": 0.3}
 

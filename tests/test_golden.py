@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import PICKS, render_small
-from render.scene import list_presets
+from render.config.scene import list_presets
 
 pytestmark = pytest.mark.xdist_group("preset_renders")  # one worker renders the presets for both
 

@@ -16,7 +16,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import ROOT, make_scene, out_folder, run_cli
-from render import pipeline, runtime
+from render.video import pipeline
+from render.physics import runtime
 
 FAN = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
 

@@ -208,7 +208,7 @@ def test_a_render_killed_with_sigkill_leaves_parts_that_the_next_render_sweeps(t
 
 def test_another_live_writers_parts_are_left_alone(tmp_path):
     """Only the temporaries of a dead process are swept: one of a live process (here: this one) stays."""
-    from render import atomic
+    from render.video import atomic
 
     mine = atomic.temp_beside(tmp_path / "x.mp4")
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,

@@ -3,8 +3,10 @@ the largest distance between neighbours' last bobs, it works for every system, a
 import numpy as np
 import pytest
 
-from render import hud, pipeline, runtime
-from render.scene import load
+from render.draw import hud
+from render.video import pipeline
+from render.physics import runtime
+from render.config.scene import load
 
 W, H, FPS = 256, 144, 10
 
@@ -14,7 +16,7 @@ def run(name, info=None, upto=None, sets=()):
     scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", "video.duration=0.5",
                         'effects=["bobs", "hud"]', *sets])
     runtime.init("cpu", scene.integrator.precision)
-    from render.canvas import Canvas
+    from render.draw.canvas import Canvas
 
     sim = pipeline.make_system(scene)
     canvas = Canvas(scene, sim, info)

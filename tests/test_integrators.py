@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from render import accuracy, reference, runtime
-from render.pipeline import make_system
-from render.scene import METHODS
+from render.commands import accuracy
+from render.physics import reference, runtime
+from render.video.pipeline import make_system
+from render.config.scene import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 # In the asymptotic regime for every method, and above the reference's ~1e-12 error even for rk4.
@@ -164,8 +165,8 @@ def test_rigid_step_symplecticity(method, symplectic):
 
 def test_every_quality_level_is_stable_on_every_preset():
     """The --quality table (chosen from the accuracy figures) must never trip the stability check."""
-    from render.quality import LEVELS
-    from render.scene import list_presets, load
+    from render.trust.quality import LEVELS
+    from render.config.scene import list_presets, load
 
     runtime.init("cpu", "f64")
     for path in list_presets():

@@ -1,6 +1,6 @@
 """`pendulum lyapunov`: the spectrum's exact identities (the sum of the exponents is −D·c at every duration), its
 pairs and their reported error over a long run, λ1 against an independent reference (scipy DOP853 on
-variational equations written here, on render/reference.py's model), and the command's files and refusals."""
+variational equations written here, on render/physics/reference.py's model), and the command's files and refusals."""
 import json
 
 import numpy as np
@@ -8,8 +8,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from conftest import run_cli
-from render import certify, lyapunov, reference
-from render.scene import load
+from render.trust import certify, lyapunov
+from render.physics import reference
+from render.config.scene import load
 
 
 @pytest.fixture(scope="module")
@@ -188,7 +189,7 @@ def test_a_render_with_the_lyapunov_effect_puts_lambda1_beside_its_certificate(t
     """effects += "lyapunov": metadata's faithfulness.lyapunov holds λ1 of the certified pendulums (thinned to
     CAP), the same λ1 `pendulum lyapunov` measures for them, and the horizon it predicts from the certificate's
     own first-frame error, beside the faithful time that certificate measured."""
-    from render import pipeline
+    from render.video import pipeline
     small = ["video.width=128", "video.height=72", "video.fps=10", "video.duration=3", 'video.formats=["mp4"]',
              'effects=["rods", "bobs", "energy", "lyapunov"]']
     scene = load("rigid_chaos", small)

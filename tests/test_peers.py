@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
-from render import peers, reference
-from render.scene import load
+from render.commands import peers
+from render.physics import reference
+from render.config.scene import load
 
 
 def bench_scene(preset, n=50):

@@ -1,10 +1,11 @@
-"""The Taichi physics against an independent formulation (render.reference, scipy DOP853 at rtol 1e-12)."""
+"""The Taichi physics against an independent formulation (render.physics.reference, scipy DOP853 at rtol 1e-12)."""
 import numpy as np
 import pytest
 import taichi as ti
 
 from conftest import make_scene
-from render import pipeline, reference, runtime
+from render.video import pipeline
+from render.physics import reference, runtime
 
 SYSTEMS = {
     "rigid": dict(pendulums={"theta1": 2.0, "theta2": -0.5, "omega1": 0.3, "omega2": -1.0, "spread": 0.4,
@@ -59,7 +60,7 @@ def test_short_trajectory_matches_dop853(system):
 
 
 def test_rk4_f64_conserves_energy_on_classic_for_10_s():
-    from render.scene import load
+    from render.config.scene import load
     scene = load("classic", ["video.duration=10.05", "video.fps=20"])
     assert scene.integrator.method == "rk4" and scene.integrator.precision == "f64"
     runtime.init("cpu", "f64")
@@ -76,7 +77,7 @@ def test_libm_trig_is_an_option_that_agrees_with_inline_on_a_regular_orbit():
     """integrator.trig = "libm" (the C library's sin/cos, whose last bits differ between CPUs) stays an option:
     on an orbit that is not chaotic (small swings, so last-bit differences do not grow), it and the inline
     sin/cos both match DOP853, and each other to round-off."""
-    from render.scene import load
+    from render.config.scene import load
     runtime.init("cpu", "f64")
     ends = {}
     for trig in ("libm", "inline"):

@@ -7,9 +7,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from conftest import run_cli
-from render import pipeline, poincare, reference, runtime
+from render.video import pipeline
+from render.physics import poincare, reference, runtime
 from render.errors import SceneError
-from render.scene import load
+from render.config.scene import load
 
 SMALL = ["video.width=256", "video.height=144", "video.fps=10"]
 
@@ -20,7 +21,7 @@ def scene_of(*overrides):
 
 def scipy_crossings(scene, q0, v0, t_end):
     """Per pendulum, (t, θ2, ω2) where θ1 ≡ 0 (mod 2π) is crossed upwards: DOP853 at rtol 1e-12 on
-    render/reference.py's equations, events at sin θ1 rising, kept where cos θ1 > 0 (θ1 ≡ π falling also
+    render/physics/reference.py's equations, events at sin θ1 rising, kept where cos θ1 > 0 (θ1 ≡ π falling also
     makes sin θ1 rise)."""
     p = reference.params(scene)
 

@@ -135,7 +135,7 @@ def test_the_readme_is_a_front_page():
 
 
 def test_the_readme_commands_table_names_every_subcommand():
-    from render.cli import build_parser
+    from render.commands.cli import build_parser
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     table = (ROOT / "README.md").read_text().split("\n## Commands\n", 1)[1].split("\n## ", 1)[0]
     assert set(sub.choices) == set(re.findall(r"^\| `pendulum (\w+)", table, re.M))
@@ -154,7 +154,7 @@ def defined_names(path) -> set[str]:
 
 
 def test_adding_a_system_lists_only_what_a_system_has():
-    from render.system import System
+    from render.physics.system import System
     section = (DOCS / "architecture.md").read_text().split("\n## Adding a system\n", 1)[1].split("\n## ", 1)[0]
     declared, implemented = section.split("class attributes:", 1)[1].split("and implements the physics once:", 1)
     attrs = set(re.findall(r"`([A-Z][A-Z0-9_]*)`", declared))

@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from conftest import ROOT, run_cli
-from render.show import DISPLAY_TIMEOUT_S
+from render.commands.show import DISPLAY_TIMEOUT_S
 
 SMALL = ["--set", "video.width=256", "--set", "video.height=144", "--set", "video.duration=1"]
 PERM = os.strerror(errno.EPERM)  # "Operation not permitted"

@@ -1,14 +1,19 @@
-"""The package's structure: systems come from the registry, nothing else names one, and imports form no cycle."""
+"""The package's structure: layers that import only downwards, systems from the registry (nothing else names one),
+and imports that form no cycle."""
 import ast
 from pathlib import Path
 
 import pytest
 
-from render import integrators, reference, registry
-from render.scene import EFFECTS, LINK_EFFECTS, load
+from render.physics import integrators, reference, registry
+from render.config.scene import EFFECTS, LINK_EFFECTS, load
 
 PKG = Path(__file__).resolve().parent.parent / "render"
-SYSTEM_DIR = PKG / "systems"
+SYSTEM_DIR = PKG / "physics" / "systems"
+
+# render/'s layers, lowest first (docs/architecture.md): a module may import its own layer and those before it.
+# The faces (render/__init__.py, __main__.py) stand above them all; errors.py below them all.
+LAYERS = ("errors", "physics", "trust", "draw", "maps", "video", "config", "commands")
 
 
 def module_name(path: Path) -> str:
@@ -42,7 +47,7 @@ def import_graph() -> dict[str, set[str]]:
     known = {module_name(f) for f in files}
     graph = {module_name(f): imported_modules(f, known) - {module_name(f)} for f in files}
     # The registry imports every system module by discovery (importlib), which ast cannot see.
-    graph["render.registry"] |= {module_name(f) for f in SYSTEM_DIR.glob("*.py") if f.name != "__init__.py"}
+    graph["render.physics.registry"] |= {module_name(f) for f in SYSTEM_DIR.glob("*.py") if f.name != "__init__.py"}
     return graph
 
 
@@ -69,9 +74,29 @@ def find_cycle(graph):
 
 def test_the_import_graph_of_render_has_no_cycle():
     graph = import_graph()
-    assert {"render.batch", "render.options", "render.errors"} <= graph["render.cli"]  # the graph is read
-    assert "render.api" in graph["render"]  # lazy imports too (the package re-exports the API on first use)
+    assert {"render.commands.batch", "render.config.options", "render.errors"} <= graph["render.commands.cli"]  # the graph is read
+    assert "render.commands.api" in graph["render"]  # lazy imports too (the package re-exports the API on first use)
     assert find_cycle(graph) is None, " -> ".join(find_cycle(graph))
+
+
+def layer(module: str) -> int:
+    """The rank of a render.* module's layer; the package's faces above every layer."""
+    parts = module.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else len(LAYERS)
+
+
+def test_every_module_lives_in_a_layer_and_imports_only_downwards():
+    graph = import_graph()
+    faces = {"render", "render.__main__"}
+    assert not {m for m in graph if layer(m) == len(LAYERS)} - faces, "a module outside the layers"
+    upward = sorted(f"{m} -> {d}" for m, deps in graph.items() for d in deps
+                    if m not in faces and layer(d) > layer(m))
+    assert not upward, upward
+
+
+def test_the_layer_check_sees_an_upward_import():
+    assert layer("render.physics.system") < layer("render.draw.canvas") < layer("render.commands.cli")
+    assert layer("render.errors") == 0 and layer("render") == len(LAYERS)
 
 
 def test_the_cycle_finder_finds_a_cycle():
@@ -91,7 +116,7 @@ def test_no_module_outside_the_systems_and_the_registry_names_a_system():
     assert not offenders, offenders
 
 
-@pytest.mark.parametrize("module", ["canvas.py", "hud.py"])
+@pytest.mark.parametrize("module", ["draw/canvas.py", "draw/hud.py"])
 def test_the_canvas_reads_only_the_drawing_contract(module):
     """The canvas (and the HUD it draws) never reaches into a system's private fields (sim.m1, sim.l1, ...)."""
     contract = {"points", "q", "n", "LINKS", "reach", "bob_sizes", "lengths"}

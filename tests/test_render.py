@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import SMALL_FPS, SMALL_H, SMALL_SECONDS, SMALL_W, out_folder, run_cli, small_scene
-from render.scene import list_presets, load
-from render.system import DEFAULT_MAX_DRIFT
+from render.config.scene import list_presets, load
+from render.physics.system import DEFAULT_MAX_DRIFT
 
 pytestmark = pytest.mark.xdist_group("preset_renders")  # one worker renders the presets for both
 

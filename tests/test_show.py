@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT, run_cli
-from render.show import Player, png_bytes
+from render.commands.show import Player, png_bytes
 
 APT = "apt-get install -y xvfb xdotool"
 W, H, FPS, SECONDS = 256, 144, 10, 5.0
@@ -140,8 +140,8 @@ def test_png_bytes_round_trip():
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
     """Every raw frame `pendulum render` encodes for the small classic scene."""
-    from render import pipeline
-    from render.scene import load
+    from render.video import pipeline
+    from render.config.scene import load
 
     frames = []
     pipeline.render(load("classic", SETS), tmp_path_factory.mktemp("ref"),
@@ -150,8 +150,8 @@ def reference(tmp_path_factory):
 
 
 def test_pipeline_source_matches_render_and_restarts_exactly(reference):
-    from render.pipeline import Source
-    from render.scene import load
+    from render.video.pipeline import Source
+    from render.config.scene import load
 
     src = Source(load("classic", SETS))
     assert src.frames == len(reference) == int(FPS * SECONDS) and src.name == "classic"

@@ -1,12 +1,13 @@
-"""render/sincos.py against numpy's long-double sin/cos (the exact value, for f64 and f32 ulps), and the chunked
+"""render/physics/sincos.py against numpy's long-double sin/cos (the exact value, for f64 and f32 ulps), and the chunked
 advance kernel that uses it: bit-identical at 1 and 2 threads and whatever a pendulum's place in its group."""
 import numpy as np
 import pytest
 import taichi as ti
 
 from conftest import make_scene
-from render import pipeline, runtime
-from render.sincos import sincos
+from render.video import pipeline
+from render.physics import runtime
+from render.physics.sincos import sincos
 
 LANES = 8
 PI_LONG = np.longdouble("3.14159265358979323846264338327950288")

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import make_scene, run_cli
-from render import integrators, pipeline, registry, runtime
+from render.physics import integrators, registry, runtime
+from render.video import pipeline
 from render.errors import SimulationError
 
 STARTS = 20
@@ -70,7 +71,7 @@ def test_rk2_on_springs_at_095_of_its_stated_limit_runs_clean(stiffness, damping
 
 
 def test_the_energy_limit_is_measured_the_same_every_time():
-    from render import stability
+    from render.physics import stability
     system, pend = random_starts()[0]
     scene = make_scene(system, 1, pendulums=pend, integrator={"method": "symplectic_euler"},
                        video={"fps": 2, "duration": DURATION})

@@ -1,4 +1,4 @@
-"""The triple pendulum against the independent N-link chain of render.reference (scipy DOP853), its energy,
+"""The triple pendulum against the independent N-link chain of render.physics.reference (scipy DOP853), its energy,
 and the limit of a vanishing third mass, where its first two links are the double pendulum."""
 import math
 
@@ -7,7 +7,8 @@ import pytest
 import taichi as ti
 
 from conftest import make_scene, run_cli
-from render import pipeline, reference, runtime
+from render.video import pipeline
+from render.physics import reference, runtime
 
 PEND = {"theta1": 2.0, "theta2": -0.5, "theta3": 2.8, "omega1": 0.3, "omega2": -1.0, "omega3": 0.7,
         "spread": 0.4, "lengths": [1.0, 0.7, 0.5], "masses": [1.5, 0.8, 1.2], "gravity": 9.81}

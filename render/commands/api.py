@@ -1,0 +1,138 @@
+"""The Python API: `load`, `render`, `simulate` and `compare`. The CLI is a thin layer over it.
+
+Every check the command line makes before any work lives here, so a notebook gets the same refusals as a
+shell: bad input raises SceneError (the CLI's exit 2) before anything is written, a failure while running
+raises SimulationError or EncodeError (exit 1), the file system's errors are OSErrors naming the file.
+
+    import render
+    scene = render.load("classic", **{"video.duration": 2}, video={"width": 640, "height": 360})
+    result = render.render(scene, out="out")      # a RenderResult: paths, metadata, certificate
+    traj = render.simulate(scene)                 # a Trajectory: t, theta/omega or pos/vel, energy
+    both = render.compare("rigid_chaos", vary={"integrator.precision": ["f32", "f64"]})  # a split screen
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..config import budget, scene as scenes
+from . import comparison
+from ..video import pipeline
+from ..physics import registry
+from ..errors import SceneError
+from ..config.options import check_arch, check_out_folder, check_replaceable, check_threads, check_writable
+from .results import RenderResult, Trajectory
+
+
+def load(preset: str | os.PathLike, /, *settings: str, quality: str | None = None, **overrides) -> scenes.Scene:
+    """The frozen, validated Scene of a preset (a name on the preset search path, or a .toml file).
+
+    Overrides are dotted keys, `load("classic", **{"video.duration": 2})`, or nested dicts,
+    `load("classic", video={"duration": 2})`; `settings` are strings as `--set` takes them
+    ("video.duration=2", the value in TOML). `quality` is a --quality level (draft, standard, high, reference).
+    """
+    values = {}
+    for key, value in overrides.items():
+        _flatten(key, value, values)
+    return scenes.load(os.fspath(preset), settings, quality, values)
+
+
+def _flatten(key: str, value, out: dict) -> None:
+    """video={"duration": 2} -> out["video.duration"] = 2; numpy scalars and arrays, tuples as plain TOML
+    values (the validator checks types as TOML gives them)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _flatten(f"{key}.{k}", v, out)
+        return
+    if key in out:  # {"video.fps": 30, "video": {"fps": 60}}: neither may silently win
+        raise SceneError(f"{key}: given twice (once dotted, once in a nested dict); give it once")
+    out[key] = _plain(value)
+
+
+def _plain(value):
+    if hasattr(value, "tolist") and callable(value.tolist):  # numpy scalar or array
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _scene(scene) -> scenes.Scene:
+    return scene if isinstance(scene, scenes.Scene) else load(scene)
+
+
+def check_render(scene_list, out: Path) -> None:
+    """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder), a
+    scene over the budget."""
+    out = Path(out)
+    for scene in scene_list:
+        check_out_folder(scene, out)
+        if scene.has("lyapunov"):  # an integrator with no tangent map, too few frames for the error
+            from ..trust import lyapunov
+            lyapunov.check(scene, lyapunov.default_pendulums(scene))
+        budget.check(scene, registry.get(scene.system), out)
+
+
+def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads: int | None = None,
+           progress: bool = False) -> RenderResult:
+    """Render a Scene (or a preset name) into OUT/NAME/: MP4 and GIF as the scene's formats say, and
+    metadata.json. Returns the paths, the metadata and the faithfulness certificate."""
+    scene = _scene(scene)
+    arch, threads, out = check_arch(arch), check_threads(threads), Path(out)
+    check_render([scene], out)
+    meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
+    return RenderResult(scene, scene.out_dir(out), meta)
+
+
+def check_npz(out: Path, name: str) -> None:
+    """Refuse (SceneError) a trajectory file that cannot be written, before any work."""
+    if out.suffix != ".npz":
+        raise SceneError(f"--out {out}: must end in .npz")
+    if out.is_dir():
+        raise SceneError(f"--out {out}: is a directory; give the file to write, e.g. {out / name}.npz")
+    check_writable(out.parent, f"--out {out}: its folder")
+    check_replaceable(out)
+
+
+def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
+             progress: bool = False) -> Trajectory:
+    """Simulate a Scene (or a preset name) without drawing: the state at every frame time, as the .npz of
+    `pendulum simulate` holds it. Nothing is written unless `out` names a .npz file."""
+    scene, arch = _scene(scene), check_arch(arch)
+    out = Path(out) if out is not None else None
+    if out is not None:
+        check_npz(out, scene.name)
+    budget.check(scene, registry.get(scene.system), out.parent if out is not None else None, simulate=True)
+    try:
+        info = pipeline.simulate(scene, out, arch=arch, progress=progress)
+    except OSError as e:  # e.g. a full disk while writing: numpy's error does not say which file
+        if out is not None and e.filename is None and e.strerror:
+            raise OSError(e.errno, e.strerror, str(out)) from e
+        raise
+    return Trajectory(scene, info.pop("arrays", {}), info, out)
+
+
+def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.PathLike = "out", *, arch: str = "cpu",
+            threads: int | None = None, progress: bool = False) -> RenderResult:
+    """The split-screen comparison `pendulum compare` renders: `vary` maps dotted keys to one value per panel
+    (2 to 4), paired key by key, e.g. {"integrator.precision": ["f32", "f64"]}, or is what --vary takes,
+    "integrator.precision=f32,f64", or a list of those; without it, the preset's own [compare] table.
+    Writes OUT/compare/NAME/; the result's metadata has every variant under "compare"."""
+    scene = _scene(scene)
+    check_arch(arch)  # before the variants are built
+    check_threads(threads)
+    if isinstance(vary, str):
+        vary = [vary]
+    if isinstance(vary, dict):
+        values = {}
+        for key, val in vary.items():
+            _flatten(key, val, values)
+        scene = comparison.with_table(scene, values)
+    elif isinstance(vary, (list, tuple)) and all(isinstance(v, str) for v in vary):  # [] as no --vary
+        scene = comparison.with_vary(scene, list(vary))
+    elif vary is not None:
+        raise SceneError(f"vary={type(vary).__name__}: must be a dict {{KEY: [V1, V2]}}, a string 'KEY=V1,V2' as "
+                         f"--vary takes it, or a list of such strings")
+    elif not scene.compare:
+        raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give vary={{KEY: [V1, V2]}}")
+    return render(scene, out, arch=arch, threads=threads, progress=progress)

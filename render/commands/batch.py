@@ -1,0 +1,350 @@
+"""`pendulum batch`: render many presets, or a sweep of one, in worker processes or on a Dask cluster.
+
+Every preset is loaded and validated here, in the parent, so a bad one fails alone before any worker starts
+and an up-to-date output is skipped without one. Renders run in spawned processes (each owns its Taichi
+runtime) or as Dask tasks; each returns a plain dict, errors included, so nothing depends on pickling
+exceptions. A summary table goes to stdout, out/batch.json records the rows and out/index.html is rebuilt.
+"""
+from __future__ import annotations
+
+import difflib
+import fnmatch
+import glob
+import hashlib
+import itertools
+import json
+import os
+import re
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+
+from ..config import budget
+from . import gallery
+from ..physics import registry
+from ..video.atomic import write_atomic
+from ..errors import BatchError, SceneError
+from ..config.options import (add_budget, add_common, add_quality, budgeted, check_writable, output_name, positive_int,
+                      progress_wanted, thread_count)
+from ..config.scene import SCHEMA, list_presets, load, parse_override, preset_path
+from ..video.version import __version__
+
+_RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
+
+
+def add_parser(sub):
+    b = sub.add_parser("batch", help="render many presets (default: all) in parallel, locally or on Dask",
+                       description="Render every preset (or those named or globbed) into OUT/NAME/ like "
+                                   "`render`, skipping up-to-date outputs; print a summary, write "
+                                   "OUT/batch.json and the gallery OUT/index.html.")
+    b.add_argument("presets", nargs="*", metavar="PRESET|GLOB",
+                   help="preset names, .toml paths or globs of either (default: every file in presets/)")
+    add_common(b)
+    b.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    b.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="J",
+                   help="local worker processes (default: the number of cores)")
+    b.add_argument("--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
+                   help="run on this Dask scheduler, e.g. tcp://host:8786 (default: $DASK_SCHEDULER_ADDRESS); "
+                        "--out must then be a directory the workers share")
+    b.add_argument("--force", action="store_true", help="render again even when the output is up to date")
+    b.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2,...",
+                   help="render one variant per value (OUT/NAME__KEY_VALUE); repeat for a grid")
+    add_quality(b)
+    add_budget(b)
+    b.add_argument("--threads", type=thread_count, default=None,
+                   help="Taichi CPU threads per render (default: cores / jobs locally, all cores on Dask)")
+    b.add_argument("--digest", action="store_true",
+                   help="record a sha256 of each render's raw frames in OUT/batch.json (reproducibility checks)")
+    b.add_argument("--no-progress", action="store_true", help="no per-preset progress lines on stderr")
+    b.set_defaults(func=run)
+
+
+# ---------------------------------------------------------------- planning (parent process)
+
+
+def expand_refs(refs: list[str]) -> list[str]:
+    """Names, paths and globs -> preset refs, in order, without repeats; a glob matching nothing is bad input."""
+    if not refs:
+        return [str(p) for p in list_presets()]
+    out = []
+    for ref in refs:
+        if not any(c in ref for c in "*?["):
+            preset_path(ref)  # a missing preset is a bad command line (exit 2), not a failed render
+            out.append(ref)
+        elif "/" in ref or ref.endswith(".toml"):
+            out += sorted(glob.glob(ref)) or _no_match(ref)
+        else:
+            out += [str(p) for p in list_presets() if fnmatch.fnmatchcase(p.stem, ref)] or _no_match(ref)
+    return list(dict.fromkeys(out))
+
+
+def _no_match(ref):  # an expression, so `matches or _no_match(ref)` reads as one line
+    raise SceneError(f"{ref}: matches no preset (see 'pendulum presets')")
+
+
+def check_key(key: str, what: str):
+    """An override key must exist in the preset schema; checked once here instead of failing every preset."""
+    node = SCHEMA
+    for i, part in enumerate(key.split(".")):
+        if not isinstance(node, dict) or part not in node:
+            close = difflib.get_close_matches(part, list(node) if isinstance(node, dict) else [], n=1)
+            hint = f" (did you mean '{'.'.join(key.split('.')[:i] + close)}'?)" if close else ""
+            raise SceneError(f"{what} {key}: unknown key{hint}")
+        node = node[part]
+    if isinstance(node, dict):
+        raise SceneError(f"{what} {key}: is a section; give a key inside it")
+
+
+def parse_sweeps(items: list[str], what: str = "--sweep") -> list[tuple[str, list[tuple[str, str]]]]:
+    """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]; `what` names the option in errors (`compare`
+    parses its --vary lists here too)."""
+    sweeps = []
+    for item in items:
+        key, sep, values = item.partition("=")
+        key = key.strip()
+        if not sep or not values.strip():
+            raise SceneError(f"{what} {item!r}: expected KEY=V1,V2,...")
+        if key == "name":
+            raise SceneError(f"{what} name: variants are named after the swept values")
+        check_key(key, what)
+        vals = []
+        for raw in _split_top(values, what):
+            _, value = parse_override(f"{key}={raw}", what)
+            vals.append((raw, _sanitize(_text(value))))
+        if len({t for _, t in vals}) != len(vals):
+            raise SceneError(f"{what} {key}: lists a value twice")
+        sweeps.append((key, vals))
+    return sweeps
+
+
+def _split_top(text: str, what: str = "--sweep") -> list[str]:
+    parts = [v.strip() for v in re.split(r",(?![^\[]*\])", text)]  # commas inside [...] do not split
+    if not all(parts):
+        raise SceneError(f"{what}: empty value in {text!r}")
+    return parts
+
+
+def _text(value) -> str:
+    """Canonical text of a parsed value, so 1e-5 and 0.00001 name the same variant."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, list):
+        return ",".join(_text(v) for v in value)
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _sanitize(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.\-]", "_", text)
+
+
+def variant_name(base: str, assignment: tuple[tuple[str, str], ...]) -> str:
+    """rigid_chaos + (('pendulums.spread', '1e-05'),) -> 'rigid_chaos__pendulums.spread_1e-05'."""
+    return "__".join([base] + [f"{k}_{t}" for k, t in assignment])
+
+
+def plan(refs, overrides, sweeps, quality=None) -> list[dict]:
+    """One job per output: {'name', 'scene'} or, when the preset is bad, {'name', 'error'}.
+
+    As with `render`, OUT/NAME/ is only ever the preset as written: with --set or --quality a render is
+    NAME__<short hash> (options.output_name), a sweep's NAME__KEY_VALUE__<short hash>."""
+    for item in overrides:
+        check_key(".".join(parse_override(item)[0]), "--set")
+    overridden = bool(overrides or quality)
+    jobs = []
+    for ref in refs:
+        try:
+            base = load(ref, overrides, quality)
+        except SceneError as e:
+            jobs.append({"name": Path(ref).stem, "error": str(e)})
+            continue
+        if not sweeps:
+            base = output_name(base, overridden)
+            jobs.append({"name": base.name, "scene": base})
+            continue
+        for combo in itertools.product(*[[(k, raw, t) for raw, t in vals] for k, vals in sweeps]):
+            name = variant_name(base.name, tuple((k, t) for k, _, t in combo))
+            sets = [*overrides, *(f"{k}={raw}" for k, raw, _ in combo), f"name={json.dumps(name)}"]
+            try:
+                scene = output_name(load(ref, sets, quality), overridden)
+                jobs.append({"name": scene.name, "scene": scene})
+            except SceneError as e:
+                jobs.append({"name": name, "error": str(e)})
+    seen = {}
+    for job in jobs:
+        if job["name"] in seen and "scene" in job:
+            raise SceneError(f"{seen[job['name']]} and {job['scene'].source} both render to {job['name']}/")
+        seen[job["name"]] = job["scene"].source if "scene" in job else job["name"]
+    return jobs
+
+
+# ---------------------------------------------------------------- rendering (worker side)
+
+
+def render_one(scene, out_root: str, arch: str = "cpu", threads: int | None = None, digest: bool = False,
+               progress: bool = False) -> dict:
+    """Render one scene; never raises for a failed render, so every executor reports it the same way."""
+    t0 = time.perf_counter()
+    h = hashlib.sha256() if digest else None
+    hook = (lambda f, frame: h.update(frame.tobytes())) if digest else None
+    try:
+        with _RENDER_LOCK:
+            from ..video import pipeline
+            meta = pipeline.render(scene, Path(out_root), arch=arch, progress=progress, threads=threads,
+                                   frame_hook=hook)
+    except Exception as e:  # noqa: BLE001 - any failure is this preset's row, not the batch's end
+        lines = [line.strip() for line in str(e).splitlines() if line.strip()] or [""]
+        # One line for the table; Taichi puts the cause last, after "File ..., line N, in kernel".
+        msg = lines[0] if len(lines) == 1 else f"{lines[-1]} ({lines[0].rstrip(':')})"
+        if not isinstance(e, (SceneError, RuntimeError)) or not msg:
+            msg = f"{type(e).__name__}: {msg}".rstrip(": ")
+        return {"preset": scene.name, "status": "failed", "error": msg, "wall_s": time.perf_counter() - t0}
+    row = gallery.row_from_meta(scene.name, "ok", meta, time.perf_counter() - t0)
+    row["raw_frames_sha256"] = h.hexdigest() if h else None
+    return row
+
+
+def _worker_init():
+    # The parent handles Ctrl-C and stops workers with SIGTERM; SystemExit lets the pipeline remove partials.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    os.dup2(2, 1)  # Taichi's start-up line would interleave with the parent's summary table on stdout
+
+
+def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
+    """Yield result rows as renders finish: in this process for one job, else in spawned workers."""
+    if jobs == 1:
+        for scene in scenes:
+            yield render_one(scene, str(out_root), arch, threads, digest, progress)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn"), initializer=_worker_init)
+    try:
+        futs = {pool.submit(render_one, s, str(out_root), arch, threads, digest): s for s in scenes}
+        for fut in as_completed(futs):
+            try:
+                yield fut.result()
+            except Exception as e:  # noqa: BLE001 - e.g. a worker killed by the OS
+                yield {"preset": futs[fut].name, "status": "failed",
+                       "error": f"worker died: {str(e) or type(e).__name__}"}
+    except BaseException:
+        for proc in list((getattr(pool, "_processes", None) or {}).values()):
+            proc.terminate()  # no public API stops running tasks; SIGTERM lets each clean up its partials
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def scheduler_address(text: str | None) -> str | None:
+    """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client."""
+    if not text:
+        return None
+    address = text if "://" in text else f"tcp://{text}"
+    # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
+    # raise in a background thread and hang)
+    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
+    port = m and m.group(3)
+    if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
+        raise SceneError(f"--scheduler {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
+    return address
+
+
+def run_dask(scenes, out_root, address, arch, threads, digest):
+    """Yield result rows as Dask tasks finish; outputs are written by the workers into out_root."""
+    from dask.distributed import Client, as_completed
+    try:
+        client = Client(address, timeout="10s", set_as_default=False)
+    except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...), no batch
+        raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
+    futs = {}
+    try:
+        for s in scenes:
+            fut = client.submit(render_one, s, str(out_root), arch, threads, digest, pure=False,
+                                key=f"pendulum-render-{s.name}-{os.urandom(4).hex()}")
+            futs[fut] = s
+        for fut in as_completed(list(futs), loop=client.loop):
+            try:
+                yield fut.result()
+            except Exception as e:  # noqa: BLE001 - e.g. KilledWorker
+                yield {"preset": futs[fut].name, "status": "failed", "error": f"{type(e).__name__}: {e}"}
+    finally:
+        client.cancel(list(futs))  # a no-op for finished tasks; stops queued ones when we are interrupted
+        client.close()
+
+
+# ---------------------------------------------------------------- the command
+
+
+def run(args) -> int:
+    t0 = time.perf_counter()
+    address = scheduler_address(args.scheduler)
+    jobs_plan = plan(expand_refs(args.presets), args.overrides, parse_sweeps(args.sweep), args.quality)
+    check_writable(args.out)
+    out_root = args.out.resolve()  # absolute: Dask workers may run elsewhere with another cwd
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    rows: dict[str, dict] = {}
+    todo = []
+    for job in jobs_plan:
+        if "scene" in job:
+            try:  # what each render costs, refused before any work as a bad preset is
+                job["scene"] = budgeted(job["scene"], args)
+                budget.check(job["scene"], registry.get(job["scene"].system), out_root)
+            except SceneError as e:
+                job["error"] = str(e)
+        if "error" in job:
+            rows[job["name"]] = {"preset": job["name"], "status": "failed", "error": job["error"]}
+        elif not args.force and (meta := gallery.up_to_date(job["scene"], out_root)):
+            rows[job["name"]] = gallery.row_from_meta(job["name"], "skipped", meta, None)
+        else:
+            todo.append(job["scene"])
+    if todo:
+        budget.check_run(todo, out_root)  # the renders to do, summed: refused together before the first
+    n, done = len(jobs_plan), 0
+
+    def report(row):
+        nonlocal done
+        done += 1
+        rows[row["preset"]] = row
+        if not args.no_progress:
+            wall = f" in {row['wall_s']:.1f}s" if row.get("wall_s") is not None else ""
+            err = f": {row['error']}" if row["status"] == "failed" else ""
+            print(f"[{done}/{n}] {row['preset']}: {row['status']}{wall}{err}", file=sys.stderr, flush=True)
+
+    for row in list(rows.values()):
+        report(row)
+    jobs = min(args.jobs or cores, max(1, len(todo)))  # no idle workers to spawn
+    mode = f"dask {address}" if address else f"local, {args.jobs or cores} job(s)"
+    if todo:
+        if address:
+            results = run_dask(todo, out_root, address, args.arch, args.threads, args.digest)
+        else:
+            # Workers share the cores: a Taichi pool per worker sized to its share avoids oversubscription.
+            threads = args.threads or (max(1, cores // jobs) if jobs > 1 else None)
+            results = run_local(todo, out_root, jobs, args.arch, threads, args.digest,
+                                jobs == 1 and progress_wanted(args))
+        try:
+            for row in results:
+                report(row)
+        except BatchError as e:
+            print(f"pendulum: failed: {e}", file=sys.stderr)
+            return 1
+    if address:
+        folders = {j["name"]: j["scene"].out_dir(out_root) for j in jobs_plan if "scene" in j}
+        for name, row in rows.items():
+            if row["status"] == "ok" and not (folders[name] / "metadata.json").is_file():
+                print(f"warning: {name} was rendered but {folders[name]} is not visible here; --out must be "
+                      f"a directory shared by this machine and the workers", file=sys.stderr)
+    ordered = [rows[j["name"]] for j in jobs_plan]
+    wall = time.perf_counter() - t0
+    record = {"package": __version__, "mode": mode, "wall_s": round(wall, 3), "results": ordered}
+    out_root.mkdir(parents=True, exist_ok=True)  # absent when nothing rendered, e.g. every preset was bad
+    write_atomic(out_root / "batch.json", json.dumps(record, indent=2) + "\n")
+    index = gallery.write_index(out_root, [(r["preset"], r["error"]) for r in ordered if r["status"] == "failed"])
+    print(gallery.summary_table(ordered))
+    counts = {s: sum(r["status"] == s for r in ordered) for s in ("ok", "skipped", "failed")}
+    print(f"{n} preset(s): {counts['ok']} ok, {counts['skipped']} skipped, {counts['failed']} failed "
+          f"in {wall:.1f}s ({mode}) -> {index}")
+    return 1 if counts["failed"] else 0
+

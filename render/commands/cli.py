@@ -1,0 +1,173 @@
+"""The `pendulum` command. Exit codes: 0 ok, 1 failure while running, 2 bad input, 130/143 interrupted.
+
+Whatever goes wrong, the user reads one line on stderr, never a traceback: bad input is exit 2, a failure
+while running (the watchdog, ffmpeg, a full disk, or an error nobody foresaw) exit 1. `--debug` or
+PENDULUM_DEBUG=1 prints the traceback as well.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import traceback
+from pathlib import Path
+
+from . import accuracy, batch, bench, comparison, gallery, lyapunov_cli, show
+from ..errors import BatchError, EncodeError, SceneError, SimulationError
+from ..config.options import add_budget, add_common, add_quality, add_render_options, budgeted, output_name, progress_wanted
+
+# Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
+MODULES = (accuracy, batch, bench, comparison, gallery, lyapunov_cli, show)
+
+
+class Terminated(BaseException):
+    """SIGTERM, turned into an exception so every `finally`/cleanup runs."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2 (argparse prints usage too by default)
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see --help)\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
+               epilog="Presets live in presets/*.toml; see docs/presets.md for the format.")
+    p.add_argument("--debug", action="store_true", help="on an error, print the traceback too "
+                   "(or set PENDULUM_DEBUG=1)")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+
+    r = sub.add_parser("render", help="render presets to out/NAME/ (MP4, GIF, metadata.json)",
+                       description="Simulate each preset, draw every frame offscreen and encode MP4 and GIF "
+                                   "into OUT/NAME/ with a metadata.json. OUT/NAME/ is only ever the preset as "
+                                   "written: with --set or --quality the render goes to OUT/NAME__<short hash of "
+                                   "the resolved scene>/ (or the folder --name gives), and says where. A preset "
+                                   "with a [compare] table renders its split-screen comparison into "
+                                   "OUT/compare/NAME/ (see `pendulum compare`).")
+    r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
+    add_render_options(r)
+    r.set_defaults(func=cmd_render)
+
+    s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",
+                       description="Write t, the state (theta/omega or pos/vel) and energy at every frame time.")
+    s.add_argument("preset", metavar="PRESET")
+    s.add_argument("--out", type=Path, required=True, metavar="FILE.npz")
+    add_common(s)
+    add_quality(s)
+    add_budget(s)
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.set_defaults(func=cmd_simulate)
+
+    ls = sub.add_parser("presets", help="list the presets, one line each")
+    ls.set_defaults(func=cmd_presets)
+
+    for module in MODULES:
+        module.add_parser(sub)
+    for command in sub.choices.values():  # --debug also after the command; main() reads it from argv
+        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    return p
+
+
+def cmd_render(args) -> int:
+    from . import api
+    from ..config import budget
+
+    scenes = [budgeted(api.load(p, *args.overrides, quality=args.quality), args) for p in args.presets]  # all first
+    if args.name and len(scenes) > 1:
+        raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
+    overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
+    scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
+    api.check_render(scenes, args.out)  # every scene's refusals before the first render
+    budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
+    for scene in scenes:
+        result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
+        print(result.line())
+    return 0
+
+
+def distinct(scenes: list, out: Path) -> list:
+    """The scenes once each; two files with the same name would overwrite one render with the other."""
+    seen = {}
+    for scene in scenes:
+        other = seen.setdefault(scene.name, scene)
+        if other.source != scene.source:
+            raise SceneError(f"{other.source} and {scene.source}: name: both are {scene.name!r}, so both would "
+                             f"render to {out / scene.name}/; rename one (name = \"...\")")
+    return list(seen.values())
+
+
+def cmd_simulate(args) -> int:
+    from . import api
+    from ..config import budget
+
+    scene = budgeted(api.load(args.preset, *args.overrides, quality=args.quality), args)
+    api.check_npz(args.out, scene.name)
+    budget.check_run([scene], args.out.parent, simulate=True)  # the estimate, when over a minute
+    traj = api.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
+    print(f"{scene.name}: {traj.info['frames']} frames, {traj.info['line']} -> {args.out}")
+    return 0
+
+
+def cmd_presets(args) -> int:
+    from ..config.scene import list_presets, load
+
+    for path in list_presets():
+        try:
+            s = load(str(path))
+            print(f"{s.name:16s} {s.system:8s} N={s.pendulums.count:<8d} {s.description}")
+        except SceneError as e:
+            print(f"{path.stem:16s} INVALID  {e}")
+    return 0
+
+
+def main(argv=None) -> int:
+    def on_term(signum, frame):
+        raise Terminated()
+
+    signal.signal(signal.SIGTERM, on_term)
+    # A process started in the background by a non-interactive shell inherits SIGINT ignored, and Python then
+    # installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. Ctrl-C or
+    # `kill -INT` always interrupts a render here (and cleans up, below).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    # read before parsing, so that even an error while parsing can show its traceback
+    debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")
+    try:
+        args = build_parser().parse_args(argv)
+        return args.func(args)
+    except SceneError as e:
+        return fail(2, "error", e, debug)
+    except (SimulationError, EncodeError, BatchError) as e:
+        return fail(1, "failed", e, debug)
+    except KeyboardInterrupt:
+        print("pendulum: interrupted; no partial output was left", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `pendulum presets | head`
+        sys.stdout = open(os.devnull, "w")
+        return 0
+    except Terminated:
+        print("pendulum: terminated; no partial output was left", file=sys.stderr)
+        return 143
+    except OSError as e:  # the file system while running: a full disk, a vanished folder, permissions
+        where = f": {e.filename}" if e.filename else ""
+        return fail(1, "failed", f"{e.strerror or e}{where}", debug)
+    except MemoryError as e:
+        return fail(1, "failed", f"out of memory ({e or 'MemoryError'})", debug)
+    except Exception as e:  # noqa: BLE001 - a bug or an unforeseen fault: still one line, not a traceback
+        why = f"{type(e).__name__}: {e}".rstrip(": ")
+        return fail(1, "unexpected error", f"{why} (run with --debug for the traceback)", debug)
+
+
+def fail(code: int, kind: str, error, debug: bool) -> int:
+    """Report an error as one line on stderr (with the traceback first under --debug); return the code."""
+    if debug:
+        traceback.print_exc()  # called from an except block: the exception being handled
+    print(f"pendulum: {kind}: {one_line(str(error))}", file=sys.stderr)
+    return code
+
+
+def one_line(text: str, limit: int = 2000) -> str:
+    """A message as one printable line: control characters escaped (file names and values may hold
+    newlines), and an overlong message cut."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text.strip())
+    return text if len(text) <= limit else text[:limit - 3] + "..."

@@ -1,0 +1,424 @@
+"""Validation of a preset's values: every key typed and within its physical range, or one SceneError line.
+
+Kept apart from the loader (scene.py) so each reads as one idea: scene.py says what a preset is and how it
+is read; this module says which values are accepted and why. A number is accepted only where f64 (and f32
+for drafts) arithmetic on it is still meaningful: finite, positive where the physics needs it, and inside
+the ranges below (systems declare theirs in render/physics/keys.py). What a valid scene *costs* is render/config/budget.py.
+
+Validator.build returns plain, validated sections; scene.from_dict turns them into the frozen Scene.
+"""
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import re
+
+from ..physics import grid, keys, registry
+from ..errors import SceneError
+from ..trust.quality import LEVELS
+from .vary import PANEL_MIN, VARIANTS, VARYING, Twice, dotted, frozen, plain, vary_refusal
+
+SYSTEMS = registry.names()
+METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
+PRECISIONS = ("f32", "f64")
+TRIGS = ("inline", "libm")  # integrator.trig: render/physics/sincos.py, or the C library's (bit for bit as the seed)
+FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
+LAYOUTS = ("fan", "grid", "shell")  # shell: on one energy shell, on the Poincaré section (render/physics/poincare.py)
+FRACTALS = ("angles", "flip_time", "divergence", "lyapunov")  # how a map (effects = ["fractal"]) colours its pixels
+MAP_DEFAULTS = {  # [map]: fractal maps only
+    "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
+    "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
+    "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
+}
+# What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
+# New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov")
+PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/draw/canvas.py)
+LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
+MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
+MAX_PIXELS = 3840 * 2160
+# The name becomes a folder and the files NAME.mp4 and .NAME.mp4.<owner>.<random>.part beside it; 100
+# characters keep every one of them far below the 255-byte limit of common file systems.
+NAME_MAX = 100
+NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.\-]*"  # letters, digits, _ . -, not starting with . or -
+DESCRIPTION_MAX = 1000  # free text shown in the gallery; longer is almost surely a mistake (a pasted file)
+# Common [pendulums] keys (each system declares its own in keys.py). Angles wrap, so beyond ±1000 rad a
+# spread only loses resolution (f64 resolves ~1e-13 rad there); gravity up to 1e4 m/s² (1000 g) and
+# damping up to 1e3 1/s (a swing stopped within milliseconds) already need steps of microseconds.
+SPREAD_MAX = 1e3
+GRAVITY_MAX = 1e4
+DAMPING_MAX = 1e3
+# f32 (drafts) spans 1e-38..3e38: the triple pendulum's mass-matrix determinant grows like (m·l²)³, so
+# lengths and masses of 1e6 overflow it and 1e-6 underflow it (NaN at the first frame). Within [1e-3, 1e3]
+# every system's f32 arithmetic stays in range.
+F32_SIZE_MIN, F32_SIZE_MAX = 1e-3, 1e3
+
+REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+
+
+
+class Validator:
+    def __init__(self, src: str, given: dict):
+        self.src = src
+        self.given = given  # the keys as written, before defaults
+
+    def fail(self, key: str, msg: str):
+        raise SceneError(f"{self.src}: {key}: {msg}")
+
+    def merge(self, raw: dict, schema: dict, prefix: str) -> dict:
+        out = {}
+        for k, val in raw.items():
+            key = prefix + k
+            if k not in schema:
+                owners = [n for n in SYSTEMS if prefix == "pendulums." and k in registry.get(n).preset_keys()]
+                if owners:
+                    self.fail(key, f"is not a key of this system (it belongs to system {' and '.join(owners)})")
+                self.fail(show_key(key), "unknown key" + hint(k, list(schema), prefix))
+            if isinstance(schema[k], dict):
+                if not isinstance(val, dict):
+                    self.fail(key, f"must be a table, got {tname(val)}")
+                out[k] = self.merge(val, schema[k], key + ".")
+            else:
+                out[k] = val
+        for k, default in schema.items():
+            if k in out:
+                continue
+            if default is REQUIRED:
+                self.fail(prefix + k, "missing (this key is required)")
+            out[k] = self.merge({}, default, prefix + k + ".") if isinstance(default, dict) else default
+        return out
+
+    # typed getters ------------------------------------------------
+    def real(self, d, sec, key, lo=-math.inf, hi=math.inf, lo_open=False):
+        val, name = d[sec][key], f"{sec}.{key}"
+        if isinstance(val, bool) or not isinstance(val, (int, float)):
+            self.fail(name, f"must be a number, got {tname(val)}")
+        try:
+            val = float(val)
+        except OverflowError:  # a TOML integer of hundreds of digits
+            self.fail(name, f"must be finite, got an integer of {len(str(abs(val)))} digits")
+        if not math.isfinite(val):
+            self.fail(name, f"must be finite, got {val}")
+        if val < lo or (lo_open and val == lo) or val > hi:
+            self.fail(name, f"must be {describe_range(lo, hi, lo_open)}, got {val:g}")
+        return val
+
+    def integer(self, d, sec, key, lo, hi):
+        val, name = d[sec][key], f"{sec}.{key}"
+        if isinstance(val, bool) or not isinstance(val, int):
+            self.fail(name, f"must be an integer, got {tname(val)}")
+        if not lo <= val <= hi:
+            self.fail(name, f"must be between {lo} and {hi}, got {clip(str(val))}")
+        return val
+
+    def choice(self, val, name, options):
+        if not isinstance(val, str):
+            self.fail(name, f"must be a string, got {tname(val)}")
+        if val not in options:
+            self.fail(name, f"unknown value {clip(repr(val))}{hint(val, list(options))}; choose from "
+                      f"{', '.join(options)}")
+        return val
+
+    def reals(self, d, sec, key, n, lo=-math.inf, hi=math.inf, lo_open=False):
+        val, name = d[sec][key], f"{sec}.{key}"
+        if not isinstance(val, list) or len(val) != n:
+            self.fail(name, f"must be a list of {_COUNT.get(n, n)} numbers, got {clip(repr(val))}")
+        sub = {sec: {f"{key}[{i}]": x for i, x in enumerate(val)}}
+        return tuple(self.real(sub, sec, f"{key}[{i}]", lo, hi, lo_open) for i in range(n))
+
+    def declared(self, d, sec, key, spec):
+        """A value of a key a system declared (render/physics/keys.py)."""
+        if isinstance(spec, keys.Reals):
+            return self.reals(d, sec, key, len(spec.default), spec.lo, spec.hi, spec.lo_open)
+        return self.real(d, sec, key, spec.lo, spec.hi, spec.lo_open)
+
+    def strings(self, val, name, options):
+        if not isinstance(val, list) or not val:
+            self.fail(name, f"must be a non-empty list of strings, got {clip(repr(val))}")
+        out = tuple(self.choice(x, name, options) for x in val)
+        if len(set(out)) != len(out):
+            self.fail(name, f"lists an entry twice: {list(out)}")
+        return out
+
+    def text(self, val, name, limit):
+        if not isinstance(val, str):
+            self.fail(name, f"must be a string, got {tname(val)}")
+        if len(val) > limit:
+            self.fail(name, f"is longer than the limit of {limit} characters ({len(val)})")
+        return val
+
+    # sections -----------------------------------------------------
+    def build(self, d: dict) -> dict:
+        """The validated sections: name, description, system, effects, pendulums, integrator, video."""
+        name = self.text(d["name"], "name", NAME_MAX)
+        if not re.fullmatch(NAME_PATTERN, name):
+            self.fail("name", f"must be a file-name-safe string (letters, digits, _ . -), got {clip(repr(name))}")
+        description = self.text(d["description"], "description", DESCRIPTION_MAX)
+        system = self.choice(d["system"], "system", SYSTEMS)
+        video = self.video(d)
+        fractal = self.fractal(d, system)
+        pend = self.pendulums(d, system, video, fractal)
+        integ = self.integrator(d, system)
+        if integ["precision"] == "f32":
+            for key in ("lengths", "masses"):
+                for i, x in enumerate(pend[key]):
+                    if not F32_SIZE_MIN <= x <= F32_SIZE_MAX:
+                        self.fail(f"pendulums.{key}[{i}]", f"{x:g} is beyond what f32 arithmetic holds here (within "
+                                  f"[{F32_SIZE_MIN:g}, {F32_SIZE_MAX:g}]); use integrator.precision = \"f64\"")
+        quality = d["quality"]
+        if quality is not None:
+            self.choice(quality, "quality", LEVELS)
+        effects = self.effects(d, system, pend, fractal)
+        if "fractal" in effects and fractal is None:
+            fractal = "angles"
+        if "lyapunov" in effects and (d.get("compare") is not None or fractal is not None):
+            self.fail("effects", "'lyapunov' measures the certified pendulums of one fan beside the certificate; "
+                      "for a comparison or a map, run `pendulum lyapunov` on the variant or pixel instead")
+        if "poincare" in effects and d.get("compare") is not None:
+            self.fail("compare", "a Poincaré section is drawn from crossings found as the pendulums are stepped, "
+                      "which a comparison's panels do not record; render each variant with --set instead")
+        return {"name": name, "description": description, "system": system, "quality": quality,
+                "budget": self.budget(d),
+                "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
+                "fractal": fractal, "map": self.map(d, fractal), "compare": self.compare(d, pend, video, fractal)}
+
+    def budget(self, d) -> float | None:
+        """The run-time budget in seconds (render/config/budget.py), a number or a text such as "2h" or "90 min"."""
+        val = d["budget"]
+        if val is None:
+            return None
+        secs = keys.seconds(val)
+        if secs is None:
+            self.fail("budget", f"must be a number of seconds or a duration such as \"90 min\" or \"2h\", got "
+                      f"{tname(val)}")
+        if not keys.BUDGET_MIN <= secs <= keys.BUDGET_MAX:
+            self.fail("budget", f"must be between {keys.BUDGET_MIN:g} s and {keys.BUDGET_MAX / 3600:g} h, got "
+                      f"{secs:g} s")
+        return secs
+
+    def fractal(self, d, system) -> str | None:
+        val = d["fractal"]
+        if val is None:
+            return None
+        self.choice(val, "fractal", FRACTALS)
+        if not registry.get(system).ANGLES:
+            self.fail("fractal", f"{val!r} colours pixels by link angles, and this system's state is not angles "
+                      f"(systems with angles: {', '.join(n for n in SYSTEMS if registry.get(n).ANGLES)})")
+        return val
+
+    def map(self, d, fractal) -> dict:
+        given = self.given.get("map") or {}
+        changed = [k for k, val in given.items() if val != MAP_DEFAULTS.get(k)]  # (a fan's own dict round trips)
+        if fractal is None and changed:
+            self.fail(f"map.{changed[0]}", "only a fractal map (effects = [\"fractal\"]) has this key")
+        eps = self.real(d, "map", "epsilon", 0.0, 1.0, lo_open=True)
+        thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
+        if fractal == "divergence" and thr <= eps:
+            self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
+        return {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096)}
+
+    def video(self, d) -> dict:
+        w = self.integer(d, "video", "width", 16, 7680)
+        h = self.integer(d, "video", "height", 16, 4320)
+        for key, val in (("width", w), ("height", h)):
+            if val % 2:
+                self.fail(f"video.{key}", f"must be even (H.264 with yuv420p), got {val}")
+        if w * h > MAX_PIXELS:
+            self.fail("video.width", f"{w}x{h} is larger than 4K ({MAX_PIXELS} pixels)")
+        fps = self.integer(d, "video", "fps", 1, 240)
+        dur = self.real(d, "video", "duration", 0.0, 3600.0, lo_open=True)
+        if round(fps * dur) < 1:
+            self.fail("video.duration", f"gives no frames at {fps} fps")
+        formats = self.strings(d["video"]["formats"], "video.formats", FORMATS)
+        trail = self.real(d, "video", "trail_seconds", 0.0, 60.0, lo_open=True)
+        gw = self.integer(d, "video", "gif_width", 16, 1920)
+        if gw % 2:
+            self.fail("video.gif_width", f"must be even, got {gw}")
+        gfps = self.integer(d, "video", "gif_fps", 1, 50)
+        palette = self.choice(d["video"]["palette"], "video.palette", PALETTES)
+        return {"width": w, "height": h, "fps": fps, "duration": dur, "formats": formats, "trail_seconds": trail,
+                "gif_width": gw, "gif_fps": gfps, "palette": palette}
+
+    def pendulums(self, d, system, video, fractal) -> dict:
+        layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
+        if layout == "grid":
+            want = grid.pendulums(video["width"], video["height"], fractal)
+            if d["pendulums"]["count"] is None:
+                d["pendulums"]["count"] = want
+            lay = grid.layout(video["width"], video["height"])
+            if d["pendulums"]["count"] != want:
+                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video['width']}x"
+                          f"{video['height']} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+        elif d["pendulums"]["count"] is None:
+            self.fail("pendulums.count", "missing (this key is required)")
+        count = self.integer(d, "pendulums", "count", 1, MAX_PENDULUMS)
+        out = {"count": count, "layout": layout}
+        out.update({k: self.declared(d, "pendulums", k, spec)
+                    for k, spec in registry.get(system).preset_keys().items()})
+        out["spread"] = self.real(d, "pendulums", "spread", -SPREAD_MAX, SPREAD_MAX)
+        if d["pendulums"]["gap"] is not None:
+            if "spread" in self.given.get("pendulums", {}):
+                self.fail("pendulums.gap", "give either pendulums.gap (between neighbours) or pendulums.spread "
+                          "(over the whole fan), not both")
+            gap = self.real(d, "pendulums", "gap", -SPREAD_MAX, SPREAD_MAX)
+            if abs(gap * count) > SPREAD_MAX:
+                self.fail("pendulums.gap", f"{gap:g} x {count} pendulums spreads the fan over {gap * count:g} rad; "
+                          f"the spread must be within [-{SPREAD_MAX:g}, {SPREAD_MAX:g}]")
+            out["spread"] = gap * count
+        out["gravity"] = self.real(d, "pendulums", "gravity", 0.0, GRAVITY_MAX)
+        out["damping"] = self.real(d, "pendulums", "damping", 0.0, DAMPING_MAX)
+        return out
+
+    def integrator(self, d, system) -> dict:
+        method = self.choice(d["integrator"]["method"], "integrator.method", METHODS[system])
+        dt = d["integrator"]["dt"]
+        if dt != "auto":
+            if isinstance(dt, str):
+                self.fail("integrator.dt", f"must be a number of seconds or \"auto\", got {clip(repr(dt))}")
+            dt = self.real(d, "integrator", "dt", 0.0, 1.0, lo_open=True)
+        prec = self.choice(d["integrator"]["precision"], "integrator.precision", PRECISIONS)
+        trig = self.choice(d["integrator"]["trig"], "integrator.trig", TRIGS)
+        allow = d["integrator"]["allow_unstable"]
+        if not isinstance(allow, bool):
+            self.fail("integrator.allow_unstable", f"must be true or false, got {tname(allow)}")
+        drift = d["integrator"]["max_drift"]
+        if drift is not None:
+            drift = self.real(d, "integrator", "max_drift", 0.0, 1e6, lo_open=True)
+        tol = self.real(d, "integrator", "tolerance", 0.0, 1.0, lo_open=True)
+        least = self.real(d, "integrator", "min_faithful", 0.0, 1.0)
+        return {"method": method, "dt": dt, "precision": prec, "trig": trig, "allow_unstable": allow,
+                "max_drift": drift, "tolerance": tol, "min_faithful": least}
+
+    def effects(self, d, system, pend, fractal) -> tuple[str, ...]:
+        given = d["effects"]
+        cls = registry.get(system)
+        if given is None and fractal is not None:
+            given = ["fractal"]  # a colouring names a map
+        eff = list(cls.DEFAULT_EFFECTS if given is None else self.strings(given, "effects", EFFECTS))
+        if fractal is not None and "fractal" not in eff:
+            self.fail("fractal", f"colours a map, and effects = {eff} draws none: use effects = [\"fractal\"]")
+        if pend["damping"] > 0 and "damping" not in eff:
+            eff.append("damping")  # a damped scene always simulates its damping
+        if "damping" in eff and pend["damping"] == 0:
+            self.fail("effects", "lists 'damping' but pendulums.damping is 0")
+        for effect, link in LINK_EFFECTS.items():
+            if effect in eff and link not in cls.LINKS:
+                having = [n for n in SYSTEMS if link in registry.get(n).LINKS]
+                self.fail("effects", f"'{effect}' draws {link}s, and this system has none: its links are "
+                          f"{list(cls.LINKS)} (systems with {link}s: {', '.join(having)})")
+        if "fractal" in eff:
+            if not cls.ANGLES:
+                self.fail("effects", "'fractal' colours pixels by link angles, and this system's state is not "
+                          "angles (systems with angles: " + ", ".join(n for n in SYSTEMS if registry.get(n).ANGLES)
+                          + ")")
+            if pend["layout"] != "grid":
+                self.fail("effects", "'fractal' colours one pendulum per pixel and needs pendulums.layout = \"grid\"")
+            clash = [e for e in eff if e in keys.DRAWN + ("hud", "glow", "poincare")]
+            if clash:
+                self.fail("effects", f"'fractal' fills every pixel; it cannot be combined with {clash}")
+        elif pend["layout"] == "grid":
+            self.fail("pendulums.layout", "a grid of pendulums is drawn with effects = [\"fractal\"]")
+        section = [n for n in SYSTEMS if registry.get(n).ANGLES and len(registry.get(n).LINKS) == 2]
+        if "poincare" in eff and system not in section:
+            self.fail("effects", "'poincare' draws the section θ1 = 0 of a double pendulum's two angles as "
+                      "(θ2, ω2) points, and this system has no such section (systems with two link angles: "
+                      f"{', '.join(section)})")
+        if pend["layout"] == "shell" and system not in section:
+            self.fail("pendulums.layout", "'shell' starts pendulums on the section θ1 = 0 of a double pendulum's two "
+                      f"angles, and this system has none (systems with two link angles: {', '.join(section)})")
+        if "glow" in eff and not any(e in eff for e in keys.DRAWN):
+            self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(keys.DRAWN)}")
+        return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
+
+
+    def compare(self, d, pend, video, fractal) -> tuple | None:
+        """[compare] vary = { KEY = [V1, V2, ...], ... }: ((key, values), ...), the keys paired (value i of
+        each makes panel i). Each value is validated when the variants are built (Scene.variants)."""
+        table = d.get("compare")
+        if table is None:
+            return None
+        if fractal is not None:
+            self.fail("compare", "a fractal map fills its whole frame and cannot be split into panels; "
+                      "render each variant with --set instead")
+        if not isinstance(table, dict):
+            self.fail("compare", f"must be a table, got {tname(table)}")
+        for k in table:
+            if k != "vary":
+                self.fail(f"compare.{show_key(k)}", "unknown key" + hint(k, ["vary"], "compare."))
+        if "vary" not in table:
+            self.fail("compare.vary", "missing (this key is required)")
+        if not isinstance(table["vary"], dict) or not table["vary"]:
+            self.fail("compare.vary", f"must be a table of KEY = [V1, V2, ...], got {tname(table['vary'])}")
+        known = sorted(dotted({k: v for k, v in d.items() if k != "compare"}))
+        try:
+            flat = dotted(table["vary"])
+        except Twice as e:
+            self.fail(f"compare.vary.{show_key(e.key)}", "given twice (quoted, and dotted or as a table); give it once")
+        out = []
+        for key, values in flat.items():
+            name = f"compare.vary.{show_key(key)}"
+            if key not in known:  # hinted among the keys a comparison may vary
+                self.fail(name, "unknown key" + hint(key, [k for k in known if not vary_refusal(k)]))
+            why = vary_refusal(key)
+            if why:
+                self.fail(name, f"cannot vary: {why}; {VARYING}")
+            lo, hi = VARIANTS
+            if not isinstance(values, list) or not lo <= len(values) <= hi:
+                self.fail(name, f"must list {lo} to {hi} values (one per panel), got {clip(repr(values))}")
+            if not all(plain(v) for v in values):
+                self.fail(name, f"values are numbers, strings, booleans or lists of them (one value of {key} "
+                          f"each), got {clip(repr(values))}")
+            if out and len(values) != len(out[0][1]):
+                self.fail(name, f"lists {len(values)} values and {out[0][0]} lists {len(out[0][1])}: varied keys "
+                          f"are paired, one value per panel")
+            out.append((key, frozen(values)))
+        columns = list(zip(*(values for _, values in out)))
+        if len(set(columns)) != len(columns):
+            self.fail("compare.vary", f"two panels would be the same variant: {clip(json.dumps(columns))}")
+        if pend["layout"] == "grid":
+            self.fail("compare", "a grid (one pendulum per pixel) cannot be split into panels")
+        rows = 1 if len(columns) == 2 else 2
+        for key, size, parts in (("width", video["width"], 2), ("height", video["height"], rows)):
+            if size // parts < PANEL_MIN:
+                self.fail(f"video.{key}", f"{size} px split into {parts} panels leaves less than {PANEL_MIN} px each")
+        return tuple(out)
+
+
+_COUNT = {1: "one", 2: "two", 3: "three", 4: "four"}
+
+
+def describe_range(lo: float, hi: float, lo_open: bool) -> str:
+    """How an accepted range reads in a message: '> 0 and <= 1', '>= 0', '> 0 and within [1e-06, 1e+06]'.
+
+    A range whose floor is above zero is a physically positive quantity, so it leads with '> 0'."""
+    upper = f" and <= {hi:g}" if hi < math.inf else ""
+    if lo == 0:
+        return (">" if lo_open else ">=") + " 0" + upper
+    if lo > 0:
+        return f"> 0 and within [{lo:g}, {hi:g}]"
+    if lo > -math.inf:
+        return f"within [{lo:g}, {hi:g}]"
+    return f"<= {hi:g}" if hi < math.inf else "a number"
+
+
+def hint(word: str, options: list[str], prefix: str = "") -> str:
+    close = difflib.get_close_matches(word, options, n=1)
+    return f" (did you mean '{prefix}{close[0]}'?)" if close else ""
+
+
+def clip(text: str, limit: int = 80) -> str:
+    """A user's value as shown in a one-line message: long values are cut, not printed whole."""
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def show_key(key: str) -> str:
+    """A key as written (TOML quoted keys may hold anything), quoted where it is not a plain dotted name."""
+    return key if re.fullmatch(r"[\w.\-]*", key) else clip(repr(key))
+
+
+def tname(val) -> str:
+    return {bool: "a boolean", str: "a string", list: "a list", dict: "a table", int: "an integer",
+            float: "a number"}.get(type(val), type(val).__name__) + (
+        f" {clip(repr(val))}" if not isinstance(val, dict) else "")

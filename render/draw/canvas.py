@@ -1,0 +1,344 @@
+"""An offscreen canvas: Taichi kernels that draw each frame straight into a numpy uint8 array.
+
+Antialiased coverage comes from the distance to each segment or circle. Primitives are composited with a
+max per channel (atomic where they are drawn in parallel), which does not depend on drawing order, so frames
+are byte-identical across runs and thread counts. Each effect has its own kernel, launched (and compiled)
+only when the scene calls for it.
+
+Speed (see benchmarks/README.md): a 720p frame is 0.9 M pixels, but a few hundred pendulums touch only a
+small part of it. Compositing works on TILE×TILE tiles that remember whether this frame's rods and bobs or a
+still-visible trail touched them; the others stay as the zeroed frame left them, and no buffer is read for
+them. The frame pass also clears the layer it reads and fades the trail in place, and it writes the output
+array itself (a kernel argument), so there is no separate clear, fade or field-to-numpy copy.
+"""
+import numpy as np
+import taichi as ti
+
+from ..physics import runtime
+
+COILS = 14  # zig-zag segments per spring
+LEAD = 0.12  # straight fraction at each end of a spring
+TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
+TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
+# On a CPU with at most this many threads, primitives are drawn by one thread with a plain max instead of
+# an atomic one: a float atomic max is a compare-exchange loop, about 2/3 of the drawing time, so one
+# thread without it beats two with it (rigid_chaos, 720p: rods+bobs 1.1 ms vs 2.9 ms of CPU per frame).
+SERIAL_MAX_THREADS = 4
+
+
+@ti.func
+def hue(h):
+    """HSV (h, 1, 1) to RGB, h in [0, 1)."""
+    k = ti.Vector([5.0, 3.0, 1.0])
+    c = (k + h * 6.0) % 6.0
+    return 1.0 - ti.max(0.0, ti.min(ti.min(c, 4.0 - c), 1.0))
+
+
+@ti.func
+def to_byte(c):
+    """One channel of the accumulated colour (f32) to a byte; monotone, so it commutes with the max."""
+    return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
+
+
+@ti.data_oriented
+class Canvas(runtime.Launcher):
+    TILE = TILE  # for render/draw/glow.py, which composes the canvas's tiles
+
+    def __init__(self, scene, sim, info=None):
+        """info: what the `hud` effect says beyond the drawing contract (render/draw/hud.py's Info; from the scene
+        alone if not given)."""
+        v, self.scene, self.sim = scene.video, scene, sim
+        self.w, self.h, self.n = v.width, v.height, sim.n
+        self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
+        self.trails = scene.has("trails")
+        self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
+        self.rainbow, self.glowing = v.palette == "rainbow", scene.has("glow")
+        self.glow, self.trail_light, light, block = None, 1.0, ti.f32, None  # layers: colour, row by row
+        if self.glowing:  # fixed-point light (render/draw/glow.py), stored tile by tile: thousands of lines in every
+            from . import glow  # direction touch it all over, and a steep line would miss the cache at every pixel
+            self.glow, self.gain, self.trail_light = glow.Glow(self.decay), glow.gain(self.n), glow.TRAIL
+            light, block = ti.i32, TILE
+        self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
+        cfg = ti.lang.impl.current_cfg()
+        self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
+        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
+        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
+        self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
+        self.section, area = None, self.w  # the pendulums' width of the frame: all of it, or left of the section
+        if scene.has("poincare"):
+            from .section import Section
+            from ..physics.keys import DRAWN
+            area = self.w // 2 if any(scene.has(e) for e in DRAWN) else 0
+            self.section = Section(self, scene, sim, area, self.w - area)
+        self.cx, self.cy = 0.5 * area, 0.5 * self.h
+        # pixels per metre, the pivot at the centre of its area: the full reach fits with a margin
+        self.scale = 0.46 * min(area or self.w, self.h) / sim.reach()
+        self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
+        self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
+        self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
+        self.tip = len(self.links) - 1
+        self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
+        self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
+        if self.trails:
+            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
+            self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
+            self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
+        self.hud = None
+        if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
+            from .hud import Hud, Info
+            self.hud = Hud(scene, sim, info or Info.of(scene), self.w, self.h)
+        self.fps = v.fps
+        self.frame_no = 0
+
+    def restart(self):
+        """Back to the first frame: no trail yet."""
+        self.frame_no = 0
+        if self.section is not None:
+            self.section.restart()
+        if self.trails:
+            self.trail.fill(0)
+            self.lit.fill(0)
+
+    def new_frame(self) -> np.ndarray:
+        """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
+        return np.zeros((self.h, self.w, 3), np.uint8)
+
+    def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
+        """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given.
+
+        t is the simulated time, for the HUD's clock (default: one frame per draw since the start)."""
+        if out is None:
+            out = self.new_frame()
+        else:
+            out.fill(0)  # compose_frame writes only the tiles something touched (a memset is far cheaper)
+        self.launch("bob_pixels")
+        if self.trails:
+            self.launch("stamp_trails", int(self.frame_no == 0))
+        if self.rods:
+            self.launch("draw_rods")
+        if self.springs:
+            self.launch("draw_spring_coils")
+        if self.bobs_on:
+            self.launch("draw_bobs")
+        self.launch("compose_frame", out)
+        if self.section is not None:
+            self.section.draw(out, self.frame_no == 0)
+        if self.hud is not None:
+            self.hud.draw(out, self.frame_no / self.fps if t is None else t)
+        self.frame_no += 1
+        return out
+
+    # ------------------------------------------------------------ primitives
+    @ti.func
+    def colour(self, i):
+        """video.palette: "fan", red to violet over the fan; "rainbow", the whole hue circle, so that a
+        coherent fan adds up to white under glow (each channel averages 1/2 over the circle)."""
+        h = 0.85 * i / ti.max(self.n - 1, 1) if self.n > 1 else 0.08
+        if ti.static(self.rainbow):
+            h = i / self.n
+        return hue(h)
+
+    @ti.func
+    def ink(self, i, max_scale, max_lift):
+        """Pendulum i's colour for a primitive: dimmed and lifted towards grey under max compositing, its
+        share of the light under glow."""
+        c = self.colour(i)
+        if ti.static(not self.glowing):
+            c = max_scale * c + max_lift
+        else:
+            c = self.gain * c
+        return c
+
+    @ti.func
+    def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c):
+        if 0 <= x < self.w and 0 <= y < self.h:
+            if ti.static(self.glowing):
+                self.glow.deposit(buf, y, x, c)
+            for k in ti.static(range(3) if not self.glowing else ()):
+                if ti.static(self.serial):
+                    buf[y, x][k] = ti.max(buf[y, x][k], c[k])
+                else:
+                    ti.atomic_max(buf[y, x][k], c[k])
+            tiles[y // TILE, x // TILE] = 1  # every writer stores the same 1: the race is harmless
+
+    @ti.func
+    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, flat: ti.template() = False):
+        """A line from a to b (x, y in pixels): under glow a hairline of light (render/draw/glow.py; `flat`: a
+        trail's pieces, which must not overlap), else antialiased with half-width r."""
+        if ti.static(self.glowing):
+            self.glow.segment(self, buf, tiles, a, b, c, flat)
+        else:
+            self.max_segment(buf, tiles, a, b, r, c)
+
+    @ti.func
+    def max_segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c):
+        """Antialiased segment of half-width r, walked along its major axis, composed with a max."""
+        swap = ti.abs(b[1] - a[1]) > ti.abs(b[0] - a[0])
+        if swap:
+            a, b = ti.Vector([a[1], a[0]]), ti.Vector([b[1], b[0]])
+        if a[0] > b[0]:
+            a, b = b, a
+        d = b - a
+        slope = d[1] / ti.max(d[0], 1e-6)
+        reach = int(ti.ceil(1.42 * r + 1.5))
+        # Pixels closer than r + 0.5 to the segment lie within this many pixels of its centre line along
+        # the minor axis (end caps included); the old fixed band of ±reach is kept as an outer bound.
+        band = (r + 0.5) * ti.sqrt(1.0 + slope * slope) + 0.01
+        ll = ti.max(d.norm_sqr(), 1e-12)
+        for u in range(int(ti.floor(a[0] - r - 1.0)), int(ti.ceil(b[0] + r + 1.0)) + 1):
+            vl = a[1] + slope * (ti.min(ti.max(u, a[0]), b[0]) - a[0])
+            vc = int(ti.round(vl))
+            lo, hi = ti.max(vc - reach, int(ti.ceil(vl - band))), ti.min(vc + reach, int(ti.floor(vl + band)))
+            for v in range(lo, hi + 1):
+                p = ti.Vector([ti.cast(u, ti.f32), ti.cast(v, ti.f32)])
+                t = ti.min(ti.max((p - a).dot(d) / ll, 0.0), 1.0)
+                cov = ti.min(ti.max(r + 0.5 - (p - a - t * d).norm(), 0.0), 1.0)
+                if cov > 0.0:
+                    if swap:
+                        self.plot(buf, tiles, u, v, c * cov)
+                    else:
+                        self.plot(buf, tiles, v, u, c * cov)
+
+    @ti.func
+    def disc(self, centre, r, c):
+        reach = int(r) + 2
+        cx, cy = int(ti.round(centre[0])), int(ti.round(centre[1]))
+        rr = (r + 0.5) * (r + 0.5)
+        for y in range(cy - reach, cy + reach + 1):
+            dy = ti.cast(y, ti.f32) - centre[1]
+            if dy * dy < rr:  # only the columns a row of the disc covers (with a hair of margin)
+                half = ti.sqrt(rr - dy * dy) + 0.01
+                for x in range(ti.max(cx - reach, int(ti.ceil(centre[0] - half))),
+                               ti.min(cx + reach, int(ti.floor(centre[0] + half))) + 1):
+                    dist = (ti.Vector([ti.cast(x, ti.f32), ti.cast(y, ti.f32)]) - centre).norm()
+                    cov = ti.min(ti.max(r + 0.5 - dist, 0.0), 1.0)
+                    if cov > 0.0:
+                        self.plot(self.rgb, self.drawn, y, x, c * cov)
+
+    # ------------------------------------------------------------ kernels, one per effect
+    @ti.func
+    def joint(self, i, j: ti.template()):
+        """Where link j of pendulum i starts: the pivot, or the previous bob."""
+        a = ti.Vector([self.cx, self.cy], ti.f32)
+        if ti.static(j > 0):
+            a = self.pos[i, j - 1]
+        return a
+
+    @ti.kernel
+    def bob_pixels(self):
+        """The system's chain points, world metres to pixels (y down), at frame times only."""
+        cx, cy = self.cx, self.cy
+        for i in range(self.n):
+            pts = self.sim.points(self.sim.q[i])
+            for j in ti.static(range(len(self.links))):
+                self.pos[i, j] = ti.Vector([cx + self.scale * pts[j, 0], cy - self.scale * pts[j, 1]], ti.f32)
+
+    @ti.kernel
+    def stamp_trails(self, first: ti.i32):
+        """The outer bob's path since the last frame into the trail layer (compose_frame fades it)."""
+        ti.loop_config(serialize=self.serial)
+        for i in range(self.n):
+            p = self.pos[i, self.tip]  # the last bob leaves the trail
+            a = p if first else self.last[i]
+            self.segment(self.trail, self.lit, a, p, self.lw, self.ink(i, 0.9, 0.0) * self.trail_light, True)
+            self.last[i] = p
+
+    @ti.kernel
+    def draw_rods(self):
+        ti.loop_config(serialize=self.serial)
+        for i in range(self.n):
+            for j in ti.static(range(len(self.links))):
+                if ti.static(self.links[j] == "rod"):
+                    self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
+                                 self.ink(i, 0.55, 0.15))
+
+    @ti.kernel
+    def draw_spring_coils(self):
+        ti.loop_config(serialize=self.serial)
+        for i, k in ti.ndrange(self.n, COILS + 2):
+            for j in ti.static(range(len(self.links))):
+                if ti.static(self.links[j] == "spring"):
+                    a, b = self.joint(i, j), self.pos[i, j]
+                    self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
+                                 self.lw, self.ink(i, 0.55, 0.15))
+
+    @ti.func
+    def coil_node(self, a, b, k):
+        """Node k of the zig-zag from a to b: straight leads, then COILS alternating offsets."""
+        t = 0.0
+        side = 0.0
+        if k == 0:
+            t = 0.0
+        elif k == COILS + 2:
+            t = 1.0
+        else:
+            t = LEAD + (1.0 - 2.0 * LEAD) * (k - 1) / COILS
+            if 1 < k < COILS + 1:
+                side = 1.0 if k % 2 == 0 else -1.0
+        d = b - a
+        nrm = ti.Vector([-d[1], d[0]]) / ti.max(d.norm(), 1e-6)
+        return a + t * d + side * self.amp * nrm
+
+    @ti.kernel
+    def draw_bobs(self):
+        ti.loop_config(serialize=self.serial)
+        for i in range(self.n):
+            for j in ti.static(range(len(self.links))):
+                self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0))
+        self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
+
+    @ti.kernel
+    def compose_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
+        """max(layer, trail) to bytes in the tiles something touched; `out` arrives zeroed.
+
+        It clears the layer and fades the trail as it reads them. Fading after reading equals the old
+        fade-before-stamp order bit for bit. A faded trail value that would print as 0 is set to exactly 0:
+        it could never show again (the byte of a max is the max of the bytes), and the tile can go dark.
+        """
+        for ty, tx in ti.ndrange(self.ty, self.tx):
+            drawn = self.drawn[ty, tx]
+            if ti.static(self.trails):
+                lit = self.lit[ty, tx]
+                if drawn and lit:  # one branch per tile, so each pixel loop is straight-line code
+                    self.lit[ty, tx] = self.tile(out, ty, tx, True, True)
+                elif lit:
+                    self.lit[ty, tx] = self.tile(out, ty, tx, False, True)
+                elif drawn:
+                    self.tile(out, ty, tx, True, False)
+            elif drawn:
+                self.tile(out, ty, tx, True, False)
+            self.drawn[ty, tx] = 0
+
+    @ti.func
+    def tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
+        lit = 0
+        if ti.static(not self.glowing):
+            lit = self.compose_tile(out, ty, tx, layer, trail)
+        else:
+            lit = self.glow.compose_tile(self, out, ty, tx, layer, trail)
+        return lit
+
+    @ti.func
+    def compose_tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
+        """One tile; returns whether any trail in it is still visible after fading."""
+        lit = 0
+        for y in range(ty * TILE, ti.min(ty * TILE + TILE, self.h)):
+            for x in range(tx * TILE, ti.min(tx * TILE + TILE, self.w)):
+                c = ti.Vector([0.0, 0.0, 0.0], ti.f32)
+                if ti.static(layer):
+                    c = self.rgb[y, x]
+                    self.rgb[y, x] = ti.Vector([0.0, 0.0, 0.0], ti.f32)
+                if ti.static(trail):
+                    t = self.trail[y, x]
+                    if t.max() > 0.0:  # most pixels of a lit tile are off the trail: nothing to fade
+                        c = ti.max(c, t)
+                        faded = ti.cast(t * self.decay, ti.f32)
+                        for k in ti.static(range(3)):
+                            if to_byte(faded[k]) == 0:
+                                faded[k] = 0.0
+                            else:
+                                lit = 1
+                        self.trail[y, x] = faded
+                for k in ti.static(range(3)):
+                    out[y, x, k] = to_byte(c[k])
+        return lit

@@ -1,0 +1,256 @@
+"""The `hud` effect: what a viewer needs to read the video, drawn over each frame from the bundled font.
+
+    top left      the simulated time, big; its colour turns amber once the first certified pendulum is no
+                  longer faithful and red once half of them are not; under it the method, precision and dt
+    top right     the certificate: until when all, and half, of the pendulums are faithful
+    bottom left   the live spread of the fan: the largest distance between neighbouring pendulums' last bobs,
+                  on a log scale over the whole video's time axis, drawn up to now; under it the timeline,
+                  with ticks where the render stops being faithful (the same times as the top right)
+    bottom right  a one-line caption: the preset's description, cut to fit
+
+In a split-screen panel (render/draw/split.py) the panel's label says the method, step, cost and error at the top,
+so the HUD keeps the spread and the timeline and puts the clock where the caption was.
+
+The left and right columns lie outside the circle the pendulums can reach (the canvas frames it at 0.92 of
+the height), so the HUD covers no pendulum on a 16:9 frame. Sizes follow the frame's height (faces()); at
+small sizes (under 360 px) the certificate's words and the axis labels are left out and its ticks and the
+clock's colour carry it. Everything is clipped to the frame.
+
+It draws into the finished uint8 frame, after the canvas composed it, so it is the same under max or glow
+compositing. Per frame: one kernel (the spread, its history and the graph, serial) and one text launch (the
+static text laid out once, the clock and the spread's value laid out per frame). The spread is a max (order
+independent) and everything drawn is drawn in order, so frames are byte-identical at any thread count.
+
+What it says beyond the drawing contract (the caption, the integrator, the certificate) comes in an Info,
+from pipeline.Source; the clock comes with each draw().
+"""
+import dataclasses
+import math
+
+import numpy as np
+import taichi as ti
+
+from ..physics import runtime
+from .font import Font, text_width
+
+WHITE, DIM, FAINT = (0.92, 0.92, 0.92), (0.55, 0.55, 0.55), (0.22, 0.22, 0.22)
+AMBER, RED, CURVE = (1.0, 0.72, 0.2), (1.0, 0.34, 0.3), (0.45, 0.85, 1.0)
+LOG_LO, LOG_HI = -8.0, 0.5  # the spread axis: log10(spread / reach); neighbours are at most 2 reaches apart
+UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
+
+
+@dataclasses.dataclass(frozen=True)
+class Info:
+    """What the HUD says that is not in the drawing contract."""
+    caption: str
+    method: str
+    dt: float | str  # the step used (or "auto" when not known)
+    precision: str
+    faithful_until_s: float | None = None  # the certificate (render/trust/certify.py), if there is one
+    median_until_s: float | None = None
+    panel: bool = False  # a split-screen panel (render/draw/split.py): its label already says method, step and error
+
+    @classmethod
+    def of(cls, scene, dt=None, cert=None, panel=False):
+        i = scene.integrator
+        return cls(scene.description, i.method, i.dt if dt is None else dt, i.precision,
+                   None if cert is None else cert.faithful_until_s, None if cert is None else cert.median_until_s,
+                   panel)
+
+
+def faces(h: int) -> tuple[tuple[str, int], tuple[str, int], tuple[str, int]]:
+    """(small, big, label) text as (font size, scale) for a frame `h` pixels high."""
+    if h < 360:
+        return ("6x13", 1), ("6x13", 1), ("6x13", 1)
+    if h < 720:
+        return ("6x13", 1), ("10x20", 1), ("6x13", 1)
+    k = h // 720
+    return ("10x20", k), ("10x20", 2 * k), ("6x13", k)
+
+
+def seconds(x: float) -> str:
+    return f"{x:.2f} s"
+
+
+def step(dt) -> str:
+    """1e-3 rather than 0.001: the exponent is what a reader compares."""
+    if isinstance(dt, str):
+        return dt
+    if dt >= 0.01:
+        return f"{dt:.3g}"
+    mant, exp = f"{dt:.2e}".split("e")
+    return f"{mant.rstrip('0').rstrip('.')}e{int(exp)}"
+
+
+def metres(d: float) -> str:
+    for unit, size in UNITS:
+        if d >= size:
+            return f"{d / size:.3g} {unit}"
+    return "< 1 nm"
+
+
+def fit(s: str, chars: int) -> str:
+    """s cut to `chars` characters, with an ellipsis when it was longer."""
+    return s if len(s) <= chars else (s[:max(chars - 1, 0)].rstrip() + "…" if chars > 0 else "")
+
+
+@ti.data_oriented
+class Hud(runtime.Launcher):
+    def __init__(self, scene, sim, info: Info, w: int, h: int):
+        self.sim, self.info, self.w, self.h = sim, info, w, h
+        v = scene.video
+        self.fps, self.duration, self.frames = v.fps, v.duration, scene.frames
+        self.n, self.tip, self.reach = sim.n, len(sim.LINKS) - 1, sim.reach()
+        self.fan = self.n > 1  # a spread needs neighbours
+        (self.small, ss), (self.big, bs), (self.lab, ls) = faces(h)
+        self.ss, self.bs, self.ls = ss, bs, ls
+        self.words = h >= 360  # room for the certificate's words and the axis labels
+        self.font = Font(self.small)
+        m = self.m = max(3, round(0.016 * h))
+        sh, bh = self.cell(self.small, ss)[1], self.cell(self.big, bs)[1]
+        self.th = max(1, h // 360)  # line thickness
+        # the panel: the spread graph over the video's time axis, the timeline under it
+        self.gx0, self.gw = m, max(16, round(0.38 * h))
+        self.gx1 = self.gx0 + self.gw
+        self.gy1 = h - m - 1 - 3 * self.th
+        self.gy0 = self.gy1 - (max(8, round(0.12 * h)) if self.fan else 0)
+        self.value_at = (self.gx0, self.gy0 - max(2, m // 3) - sh)
+        self.until = [(t, c) for t, c in ((info.faithful_until_s, AMBER), (info.median_until_s, RED))
+                      if t is not None and t < self.duration]
+        self.ticks = tuple(self.x_of(t) for t, _ in self.until) + (-1,) * (2 - len(self.until))
+        self.tick_colours = tuple(c for _, c in self.until) + (WHITE,) * (2 - len(self.until))
+        self.tick_times = tuple(float(t) for t, _ in self.until) + (math.inf,) * (2 - len(self.until))
+        rows = self.axis_labels()
+        if not info.panel:  # a panel's label covers its top, and the caption is the video's, not the panel's
+            rows += [self.text(f"{info.method} · {info.precision}", m, m + bh + m // 2),
+                     self.text(f"dt = {step(info.dt)} s", m, m + bh + m // 2 + sh)] + self.certificate()
+            right = self.gx1 + (self.cell(self.lab, ls)[0] * 5 if self.fan and self.words else 0) + 2 * m
+            chars = (w - m - right) // self.cell(self.small, ss)[0]
+            rows.append(self.text(fit(" ".join(info.caption.split()), chars), w - m, h - m, DIM, ha="right",
+                                  va="bottom"))
+        self.static = np.concatenate(rows) if rows else np.zeros((0, 10), np.int32)
+        if self.fan:
+            self.spread = runtime.field("hud.spread", runtime.real(), ())
+            self.history = runtime.field("hud.history", ti.f32, max(self.frames, 1))
+
+    # ------------------------------------------------------------ host-side layout
+    def cell(self, size, scale):
+        return text_width("x", scale, size), self.font.text_height("x", scale, size)
+
+    def text(self, s, x, y, colour=WHITE, size=None, scale=None, **kw):
+        return self.font.layout(s, x, y, colour, scale or self.ss, size=size or self.small, **kw)
+
+    def x_of(self, t: float) -> int:
+        return self.gx0 + int(round(min(max(t / self.duration, 0.0), 1.0) * self.gw))
+
+    def certificate(self) -> list:
+        """The top right block: until when all, and half, of the certified pendulums are faithful."""
+        i = self.info
+        if not self.words or i.faithful_until_s is None:
+            return []
+        first, half = i.faithful_until_s >= self.duration, i.median_until_s >= self.duration
+        lines = [("faithful to the end", WHITE)] if first else [
+            (f"all faithful to {seconds(i.faithful_until_s)}", AMBER),
+            ("half faithful to the end" if half else f"half faithful to {seconds(i.median_until_s)}",
+             WHITE if half else RED)]
+        sh = self.cell(self.small, self.ss)[1]
+        return [self.text(s, self.w - self.m, self.m + k * sh, c, ha="right") for k, (s, c) in enumerate(lines)]
+
+    def axis_labels(self) -> list:
+        """Decades of the spread axis, in metres, right of the graph."""
+        if not (self.fan and self.words):
+            return []
+        out = []
+        for unit, size in UNITS:
+            at = math.log10(size / self.reach)
+            if LOG_LO <= at <= LOG_HI:
+                out.append(self.text(f"1 {unit}", self.gx1 + 3, self.y_of(at), DIM, self.lab, self.ls, va="middle"))
+        return out
+
+    def y_of(self, log_value: float) -> int:
+        f = (min(max(log_value, LOG_LO), LOG_HI) - LOG_LO) / (LOG_HI - LOG_LO)
+        return self.gy1 - int(round(f * (self.gy1 - self.gy0)))
+
+    def clock_colour(self, t: float):
+        colour = WHITE
+        for until, c in self.until:
+            if t > until + 1e-9:
+                colour = c
+        return colour
+
+    # ------------------------------------------------------------ per frame
+    def draw(self, out: np.ndarray, t: float):
+        """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
+        frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
+        spread = self.launch("hud_graph", out, frame, self.x_of(t))  # returned: no field read, no extra launch
+        clock = f"t = {t:5.2f} s"
+        rows = [self.static, self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big,
+                                       self.bs, ha="right", va="bottom") if self.info.panel else
+                self.text(clock, self.m, self.m, self.clock_colour(t), self.big, self.bs)]
+        if self.fan:
+            label = f"{'spread' if self.words else 'Δ'} {metres(spread)}"
+            rows.append(self.text(label, *self.value_at, CURVE))
+        self.font.draw_glyphs(out, np.concatenate(rows))
+
+    @ti.func
+    def put(self, out: ti.template(), y, x, c):
+        if 0 <= x < self.w and 0 <= y < self.h:
+            for k in ti.static(range(3)):
+                old = ti.cast(out[y, x, k], ti.i32)  # (LLVM has no max of u8)
+                out[y, x, k] = ti.cast(ti.max(old, ti.cast(c[k] * 255.0 + 0.5, ti.i32)), ti.u8)
+
+    @ti.func
+    def column(self, out: ti.template(), x, y0, y1, c):
+        for y in range(ti.min(y0, y1), ti.max(y0, y1) + 1):
+            self.put(out, y, x, c)
+
+    @ti.func
+    def spread_colour(self, f):
+        """The curve's colour at frame f: as the clock's was then."""
+        t = f / self.fps
+        c = ti.Vector(CURVE)
+        for k in ti.static(range(2)):
+            if ti.static(self.ticks[k] >= 0):
+                if t > self.tick_times[k] + 1e-9:
+                    c = ti.Vector(self.tick_colours[k])
+        return c
+
+    @ti.kernel
+    def hud_graph(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), frame: ti.i32, now: ti.i32) -> float:
+        """The spread now (returned), its history, and the graph and timeline into `out`."""
+        if ti.static(self.fan):
+            self.spread[None] = 0.0
+            ti.loop_config(serialize=True)  # a few thousand pendulums at most: waking threads costs more
+            for i in range(self.n - 1):
+                a, b = self.sim.points(self.sim.q[i]), self.sim.points(self.sim.q[i + 1])
+                d = ti.Vector([b[self.tip, 0] - a[self.tip, 0], b[self.tip, 1] - a[self.tip, 1]]).norm()
+                ti.atomic_max(self.spread[None], d)
+            rel = ti.max(ti.cast(self.spread[None] / self.reach, ti.f32), 1e-30)
+            self.history[frame] = ti.log(rel) / ti.log(10.0)
+        ti.loop_config(serialize=True)  # in order: pixels are read, maxed and written back
+        for x in range(self.gx0, self.gx1 + 1):
+            axis = ti.Vector(DIM) if x <= now else ti.Vector(FAINT)
+            for j in range(self.th):
+                self.put(out, self.gy1 + 1 + j, x, axis)
+            for k in ti.static(range(2)):
+                if ti.static(self.ticks[k] >= 0):
+                    if self.ticks[k] <= x < self.ticks[k] + self.th:
+                        self.column(out, x, self.gy0, self.gy1 + 3 * self.th, ti.Vector(self.tick_colours[k]))
+            if ti.static(self.fan):
+                if x <= now:
+                    f = (x - self.gx0) * ti.max(self.frames - 1, 1) // self.gw
+                    f = ti.min(f, frame)
+                    fp = ti.min(ti.max(x - 1 - self.gx0, 0) * ti.max(self.frames - 1, 1) // self.gw, frame)
+                    y, yp = self.y_px(self.history[f]), self.y_px(self.history[fp])
+                    c = self.spread_colour(f)
+                    for j in range(self.th):
+                        self.column(out, x, yp - j, y - j, c)
+        value = 0.0
+        if ti.static(self.fan):
+            value = self.spread[None]
+        return value
+
+    @ti.func
+    def y_px(self, v):
+        f = (ti.min(ti.max(v, LOG_LO), LOG_HI) - LOG_LO) / (LOG_HI - LOG_LO)
+        return self.gy1 - ti.cast(ti.round(f * (self.gy1 - self.gy0)), ti.i32)

@@ -1,0 +1,341 @@
+"""Fractal maps: one pendulum per pixel of a θ1 × θ2 plot (render/physics/grid.py), coloured by what it does.
+
+The preset key `fractal` picks the colouring:
+- **angles**: the pixel's current angles as a colour (R sin θ1, G sin θ2, B cos(θ1 + θ2));
+- **flip_time**: the first time |θ1| or |θ2| (any link of the chain) passes π, on a log time scale;
+- **divergence**: the first time the pixel and its twin, started map.epsilon further on the last link, are
+  map.threshold apart in (θ1, θ2, ω1, ω2) (Euclidean, rad and rad/s); while they are still together,
+  their distance on a log scale in grey.
+
+Events are found at every substep (linearly interpolated within it), not at frame times, and a pixel whose
+event has happened is no longer integrated: its colour is settled. Pixels are advanced by the system's own
+integrator (integrators.step on the system's force, lane matrices as in System.advance): no physics here.
+
+**Which pixels cannot flip.** With angles from the hanging position, bob i at height −Σ_{j≤i} l_j cos θ_j and
+μ_k = m_k + ... + m_n the mass at or below link k, the potential energy (zero hanging at rest) is
+
+    V(θ) = g Σ_k μ_k l_k (1 − cos θ_k),
+
+a sum of one term per link. On the set where link k points straight up (θ_k = ±π) it is least with every
+other link hanging, where it is B_k = 2 g μ_k l_k. Energy never grows (damping only removes it) and kinetic
+energy is not negative, so a pendulum with E < B_k can never bring link k over the top, and one with
+E < B = min_k B_k flips no link at all: it is black from the first frame and never integrated. From rest,
+E = V(θ(0)); for two links of equal unit masses and lengths, B = 2g and the condition is 2 cos θ1 + cos θ2
+> 1. The bound is tight: the state with link k up and the others hanging, at rest, has E = B_k exactly, so
+no smaller barrier holds (tests/test_fractal.py: a DOP853 run flips no pixel inside it, and starts just
+above B_k with link k just short of the top do flip).
+
+**The trust mask.** A pixel shows a claim about its trajectory up to min(t, its event time). The
+certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_indices) instead of its usual 128
+pendulums, and each pixel's faithful time is the least of its lattice neighbours' (grid.faithful_map). A
+pixel whose claim reaches past that time is drawn desaturated and hatched. Pixels that cannot flip are
+trusted: energy, not the integration, settles them.
+"""
+
+import math
+
+import numpy as np
+import taichi as ti
+
+from ..draw import axes
+from ..physics import grid, integrators, runtime
+from ..draw.font import Font
+
+PENDING = -1.0  # event field: not happened (yet)
+NEVER = -2.0  # cannot happen: below the energy barrier
+# matplotlib's plasma at 9 points, read backwards on the map (early events bright): saturated everywhere,
+# so a desaturated (untrusted) pixel stands apart, and its dark end is blue, not the black of "never"
+PALETTE = ((0.05, 0.03, 0.528), (0.3, 0.01, 0.632), (0.495, 0.012, 0.658), (0.665, 0.139, 0.586),
+           (0.798, 0.28, 0.47), (0.902, 0.425, 0.36), (0.973, 0.586, 0.252), (0.993, 0.772, 0.155),
+           (0.94, 0.975, 0.131))
+STOPS = len(PALETTE)
+PENDING_GREY = 0.24  # a flip map's pixels that may still flip
+HATCH = 5  # pixels between the diagonal lines over untrusted pixels
+
+
+def barriers(masses, lengths, g: float) -> list[float]:
+    """B_k = 2 g μ_k l_k: the least energy (zero hanging at rest) with which link k can point straight up."""
+    return [2.0 * g * sum(masses[k:]) * lengths[k] for k in range(len(lengths))]
+
+
+def time_scale(duration: float) -> tuple[float, float]:
+    """The log colour scale's range in s: from 0.1 s (or a quarter of a short video) to the end."""
+    return min(0.1, duration / 4), duration
+
+
+@ti.func
+def palette(u):
+    """u in [0, 1] to PALETTE, piecewise linear."""
+    x = ti.min(ti.max(u, 0.0), 1.0) * (STOPS - 1)
+    k = ti.min(ti.cast(ti.floor(x), ti.i32), STOPS - 2)
+    f = x - k
+    c = ti.Vector([0.0, 0.0, 0.0])
+    for j in ti.static(range(STOPS - 1)):
+        if k == j:
+            c = (1.0 - f) * ti.Vector(PALETTE[j]) + f * ti.Vector(PALETTE[j + 1])
+    return c
+
+
+@ti.func
+def sin8(x):
+    """sin(x) to within 1e-4, plenty for a colour byte and about 3x cheaper than libm's call. Reduced to
+    [-pi/2, pi/2], then the Taylor series to x^9 (error < 4e-6 there)."""
+    x = x - 2.0 * math.pi * ti.round(x * (0.5 / math.pi))
+    if x > 0.5 * math.pi:
+        x = math.pi - x
+    elif x < -0.5 * math.pi:
+        x = -math.pi - x
+    x2 = x * x
+    return x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))))
+
+
+@ti.func
+def untrusted(c, x, y):
+    """The mask: most of the colour drained, and a diagonal hatch that shows on dark pixels too."""
+    lum = 0.3 * c[0] + 0.59 * c[1] + 0.11 * c[2]
+    c = 0.75 * (lum + 0.3 * (c - lum))
+    if (x + y) % HATCH == 0:
+        c = ti.Vector([0.1, 0.1, 0.1]) if lum > 0.45 else ti.Vector([0.5, 0.5, 0.5])
+    return c
+
+
+@ti.data_oriented
+class Map(runtime.Launcher):
+    """The map of a grid scene: it advances the system (events per substep) and draws every frame."""
+
+    COLOUR = "fractal_colour"  # the kernel that colours the pixels; a subclass's map names its own
+
+    def __init__(self, scene, sim, cert):
+        v, self.scene, self.sim, self.kind = scene.video, scene, sim, scene.fractal
+        self.lay = grid.layout(v.width, v.height)
+        self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.twins = self.kind == "divergence"
+        # pendulums per kernel iteration: the system's lanes, and a whole number of pairs
+        self.lanes = sim.LANES * (2 if self.twins and sim.LANES % 2 else 1)
+        self.groups = -(-sim.n // self.lanes)
+        self.barrier = min(barriers(sim.masses, sim.lengths, sim.g))
+        self.eps, self.threshold = scene.map.epsilon, scene.map.threshold
+        self.lo, self.hi = time_scale(v.duration)
+        self.log_lo, self.log_span = math.log(self.lo), math.log(self.hi / self.lo)
+        self.log_ratio = math.log(self.threshold / self.eps)
+        self.event = runtime.field("fractal.event", ti.f32, self.pixels)
+        self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
+        self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
+        self.font = Font(self.lay.font) if self.lay.font else None
+        self.background = self.decorate()
+        self.restart()
+
+    def restart(self):
+        """Every event pending again (or never, below the barrier), from the system's current (initial) state."""
+        self.launch("fractal_setup")
+
+    def new_frame(self) -> np.ndarray:
+        return np.empty((self.lay.height, self.lay.width, 3), np.uint8)  # draw() writes every pixel
+
+    # ------------------------------------------------------------ host side
+    def advance_frame(self):
+        """One frame on: the angles map is the plain advance; the others stop each pixel at its event."""
+        sim = self.sim
+        if self.kind == "angles":
+            sim.advance_frame()
+            return
+        self.launch("fractal_advance", sim.substeps, sim.h, sim.t)
+        sim.t += sim.substeps * sim.h
+
+    def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
+        """The map at the simulation's time (t, the canvas's clock argument, is the same and unused here)."""
+        if out is None:
+            out = self.new_frame()
+        np.copyto(out, self.background)
+        self.launch(self.COLOUR, out, self.sim.t)
+        if self.font:
+            x, y = self.decor.clock
+            self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")
+        return out
+
+    def summary(self) -> dict:
+        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not."""
+        ev, until = self.event.to_numpy(), self.until.to_numpy()
+        t = np.float32(self.sim.t)
+        done, pending = ev >= 0, ev == PENDING
+        claim = np.where(done, ev, t)
+        lay, stride = self.lay, self.scene.map.trust_stride
+        return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "pixels": self.pixels, "time_scale_s": [self.lo, self.hi],
+                "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
+                            * len(grid.lattice_axis(lay.h, stride))},
+                "cannot_flip": int((ev == NEVER).sum()), "events": int(done.sum()),
+                "events_trusted": int((done & (claim <= until)).sum()), "pending": int(pending.sum()),
+                "pending_trusted": int((pending & (claim <= until)).sum())}
+
+    def decorate(self) -> np.ndarray:
+        """The static parts of every frame: background, axes, labels, colour bar and legend."""
+        sim, i = self.sim, self.scene.integrator
+        self.decor = axes.decorate(self.scene, self.lay, (self.lo, self.hi),
+                                   f"{i.method} dt={1e3 * sim.h:.3g} ms {i.precision}")
+        bg = np.empty((self.lay.height, self.lay.width, 3), np.uint8)
+        bg[:] = axes.BACKGROUND
+        for x, y, w, h, rgb in self.decor.rects:
+            bg[max(y, 0):max(y + h, 0), max(x, 0):max(x + w, 0)] = rgb
+        for x, y, w, h, what in self.decor.swatches:
+            self.launch("fractal_swatch", bg, x, y, w, h, SWATCHES.index(what))
+        if self.font and self.decor.texts:
+            self.font.draw_many(bg, [(s, x, y, {"colour": axes.INK, **kw}) for s, x, y, kw in self.decor.texts])
+        return bg
+
+    # ------------------------------------------------------------ kernels
+    @ti.func
+    def pixel(self, i):
+        """The pixel of pendulum i."""
+        p = i
+        if ti.static(self.twins):
+            p = i // 2
+        return p
+
+    @ti.kernel
+    def fractal_setup(self):
+        for p in range(self.pixels):
+            self.event[p] = PENDING
+            if ti.static(self.kind == "flip_time"):
+                if self.sim.energy(self.sim.q[p], self.sim.v[p]) < self.barrier:
+                    self.event[p] = NEVER
+
+    @ti.func
+    def live(self, g):
+        """Whether any pendulum of group g still has its event ahead."""
+        live = 0
+        for lane in ti.static(range(self.lanes)):
+            i = g * self.lanes + lane
+            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+                live = 1
+        return live
+
+    @ti.func
+    def gather(self, g):
+        """System.gather at this map's width (a pair never straddles two groups)."""
+        last = self.sim.n - 1
+        q = ti.Matrix.cols([self.sim.q[ti.min(g * self.lanes + lane, last)] for lane in ti.static(range(self.lanes))])
+        v = ti.Matrix.cols([self.sim.v[ti.min(g * self.lanes + lane, last)] for lane in ti.static(range(self.lanes))])
+        return q, v
+
+    @ti.func
+    def scatter(self, g, q, v):
+        """System.scatter at this map's width, with the same watchdog."""
+        for lane in ti.static(range(self.lanes)):
+            i = g * self.lanes + lane
+            if i < self.sim.n:
+                self.sim.q[i], self.sim.v[i] = q[:, lane], v[:, lane]
+                if not (ti.abs(q[:, lane]).max() < 1e30 and ti.abs(v[:, lane]).max() < 1e30):  # also NaN
+                    ti.atomic_min(self.sim.bad[None], i)
+
+    @ti.kernel
+    def fractal_advance(self, substeps: ti.i32, h: float, t0: float):
+        """Every group with an event ahead, `substeps` steps of h on, recording events as they happen; a
+        group stops as soon as all of its events are in."""
+        for g in range(self.groups):
+            if self.live(g):
+                q, v = self.gather(g)
+                for s in range(substeps):
+                    q1, v1 = integrators.step(self.sim, q, v, h)
+                    self.events(g, q, v, q1, v1, t0 + s * h, h)
+                    q, v = q1, v1
+                    if not self.live(g):
+                        break
+                self.scatter(g, q, v)
+
+    @ti.func
+    def events(self, g, q, v, q1, v1, t, h):
+        """Events within the step from (q, v) at t to (q1, v1) at t + h, at their interpolated times."""
+        for lane in ti.static(range(0, self.lanes, 2 if self.twins else 1)):
+            i = g * self.lanes + lane
+            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+                frac = 2.0
+                if ti.static(self.twins):
+                    d0, d1 = self.distance(q, v, lane), self.distance(q1, v1, lane)
+                    if d1 > self.threshold:
+                        frac = ti.max(0.0, (self.threshold - d0) / (d1 - d0))
+                else:
+                    for k in ti.static(range(self.sim.D)):
+                        a, b = ti.abs(q[k, lane]), ti.abs(q1[k, lane])
+                        if b > math.pi and a <= math.pi:
+                            frac = ti.min(frac, (math.pi - a) / (b - a))
+                if frac <= 1.0:
+                    self.event[self.pixel(i)] = t + frac * h
+
+    @ti.func
+    def distance(self, q, v, lane: ti.template()):
+        """|(θ, ω) of pendulum `lane` − those of its twin `lane` + 1|."""
+        return ti.sqrt((q[:, lane] - q[:, lane + 1]).norm_sqr() + (v[:, lane] - v[:, lane + 1]).norm_sqr())
+
+    @ti.func
+    def time_colour(self, t):
+        """An event time on the log scale: early bright, late dark blue."""
+        u = (ti.log(ti.max(t, self.lo)) - self.log_lo) / self.log_span
+        return palette(1.0 - u)
+
+    @ti.func
+    def bar_colour(self, u):
+        """The colour bar's colour at u in [0, 1] (bottom to top): time from lo to hi, log."""
+        return self.time_colour(ti.exp(self.log_lo + u * self.log_span))
+
+    @ti.func
+    def together(self, d):
+        """A pair's distance, ε to the threshold on a log scale, as a grey."""
+        u = ti.log(ti.max(d, self.eps) / self.eps) / self.log_ratio
+        g = 0.06 + 0.5 * ti.min(u, 1.0)
+        return ti.Vector([g, g, g])
+
+    @ti.kernel
+    def fractal_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
+        """Every pixel of the plot; one claims its trajectory up to min(t, its event), trusted up to its
+        faithful time."""
+        for r, c in ti.ndrange(self.h, self.w):
+            p = r * self.w + c
+            ev = self.event[p]
+            claim = t
+            col = ti.Vector([0.0, 0.0, 0.0])
+            if ti.static(self.kind == "angles"):
+                q = self.sim.q[p]
+                col = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
+            else:
+                if ev >= 0.0:
+                    col, claim = self.time_colour(ev), ev
+                elif ev == NEVER:
+                    claim = 0.0  # settled by energy, not by the integration
+                elif ti.static(self.twins):
+                    a, b = 2 * p, 2 * p + 1
+                    col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
+                                                + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
+                else:
+                    col = ti.Vector([PENDING_GREY] * 3)
+            if claim > self.until[p]:
+                col = untrusted(col, c, r)
+            for k in ti.static(range(3)):
+                out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+
+    @ti.kernel
+    def fractal_swatch(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), x0: ti.i32, y0: ti.i32, w: ti.i32,
+                       h: ti.i32, what: ti.i32):
+        """A legend's colour bar or swatch, drawn with the plot's own colours (SWATCHES names `what`)."""
+        for r, c in ti.ndrange(h, w):
+            u = 1.0 - (r + 0.5) / h  # 0 at the bottom, 1 at the top
+            col = ti.Vector([0.0, 0.0, 0.0])
+            if what == 0:  # the colour bar
+                col = self.bar_colour(u)
+            elif what == 1:  # distance while together: ε (bottom) to the threshold
+                col = self.together(self.eps * ti.exp(u * self.log_ratio))
+            elif what == 2:
+                col = ti.Vector([PENDING_GREY] * 3)
+            elif what == 3:  # untrusted: the mask over the time colours, left to right
+                col = untrusted(palette(1.0 - (c + 0.5) / w), c, r)
+            elif what == 4:  # angles: the colours of θ1 from −π to π with θ2 = 0
+                th = math.pi * (2.0 * (c + 0.5) / w - 1.0)
+                col = 0.5 + 0.5 * ti.Vector([sin8(th), 0.0, sin8(th + 0.5 * math.pi)])
+            # what == 5: never, black
+            y, x = y0 + r, x0 + c
+            if 0 <= y < out.shape[0] and 0 <= x < out.shape[1]:
+                for k in ti.static(range(3)):
+                    out[y, x, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+
+
+SWATCHES = ("time", "distance", "pending", "untrusted", "angles", "never")

@@ -1,0 +1,212 @@
+"""The FTLE map (`fractal = "lyapunov"`): each pixel's finite-time Lyapunov exponent, live as t grows,
+
+    σ_t = (1/t) · ln s_max(DΦ(t)),
+
+DΦ(t) the 4×4 Jacobian of the numerical flow from t = 0 in the pixel's state (θ1, θ2, ω1, ω2) (rad, rad/s:
+the coordinates the divergence map measures distance in; a triple pendulum's map: 6×6), s_max its largest
+singular value; σ in 1/s.
+
+**The tangent map, exactly.** Every pixel carries four tangent vectors, the columns of M = DΦ(t)·e^{−L}
+(M = I at t = 0). Each frame, one forward-mode kernel (ti.ad.FwdMode, as in render/physics/tangent.py) runs the
+scene's own integrator over the system's own force through the frame, once per column: the four columns
+are four lanes of the same loop, each the pixel's state with that column as its dual, so the duals that come
+out are DΦ_frame·M to round-off (not a finite difference, and no physics written here). Lane 0's primal
+is the pixel's new state. Then M is divided by its largest entry m and L += ln m, which keeps it finite for
+any t; nothing else is done to it. No QR: the columns are left to align with the stretching direction, which
+loses the smaller singular values to round-off but not the largest, since s_max is well conditioned
+(|s_max(M + E) − s_max(M)| ≤ |E|), so ln s_max(DΦ(t)) = L + ln s_max(M) is the finite-t value, not the
+asymptotic rate a renormalised basis would give.
+
+**s_max per pixel.** s_max(M)² = λ_max(MᵀM): MᵀM is squared ten times (normalised each time), so that a
+column of it points along the top eigenvector but for a part (λ2/λ1)^1024, and that column's Rayleigh
+quotient is λ_max to a relative 2e-4 at worst (near-equal eigenvalues, whose mixing then hardly matters):
+far inside a colour step, and tests/test_ftle.py checks it against numpy's SVD.
+
+**What is drawn.** σ on a linear scale, 0 (dark blue) to SIGMA_MAX 1/s (yellow), negative σ (damping) as 0;
+the colour bar is in 1/s. The energy barrier (render/maps/fractal.py: a pendulum with E < B cannot flip any link)
+is the black curve E(θ1, θ2) = B: the pixels inside it next to one outside. Inside, the motion is bounded
+away from the top, and σ is still measured there, not blacked out (it is mostly small: regular motion).
+The trust mask is the other maps': every pixel claims its trajectory up to t, and is desaturated and
+hatched past the faithful time of its lattice neighbours.
+
+**Trig.** Taichi's forward mode cannot differentiate render/physics/sincos.py's inline sin/cos, so the tangent
+kernel steps a libm twin of the system (tangent.libm_twin) and its primal is the map's state. The preset
+runs in f64, where libm's sin/cos and the inline ones the certificate checks differ by about an ulp (far
+below its tolerance), and where libm's last bits, which differ between CPUs, do not grow into a different
+picture within the video as they would in a chaotic f32 map (docs/numerics.md). libm calls do not
+vectorise, and each lane carries a dual beside its primal: a frame costs 10 to 20 times the plain
+vectorised advance of the same pixels (measured on the shared 2-core machine, indicative only: 3 to 5 s a
+frame at 720p, 17 substeps), far from video speed; a forward mode through a differentiable inline sin/cos
+in the vectorised loop is the way to close that gap.
+"""
+
+import numpy as np
+import taichi as ti
+
+from . import fractal
+from ..physics import grid, integrators, runtime
+from ..draw.font import Font
+from ..physics.tangent import check_method, libm_twin, scalarized
+
+SIGMA_MAX = 2.0  # 1/s: the top of the colour scale
+SQUARINGS = 10  # of MᵀM, for its top eigenvector
+
+
+@ti.data_oriented
+class FtleMap(fractal.Map):
+    """The FTLE map of a grid scene: it carries each pixel's tangent vectors through every frame and draws σ_t."""
+
+    COLOUR = "ftle_colour"
+
+    def __init__(self, scene, sim, cert):
+        check_method(scene)
+        self.scene, self.sim, self.kind = scene, sim, scene.fractal
+        self.lay = grid.layout(scene.video.width, scene.video.height)
+        self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
+        self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
+        self.twin = libm_twin(sim)
+        self.k = 2 * sim.D  # tangent vectors per pixel: the state's dimension (4 for the double pendulum)
+        real, n, D = runtime.real(), self.k * self.pixels, self.k  # one kernel element per tangent vector
+        # dx: a zero offset to the state, whose duals are the columns of M; out: the frame's end and its duals
+        self.dx = ti.Vector.field(D, real, shape=n, needs_dual=True)
+        self.out = ti.Vector.field(D, real, shape=n, needs_dual=True)
+        runtime.allocated["ftle.tangents"] = 4 * n * D * (8 if real == ti.f64 else 4)  # the two and their duals
+        self.loss = ti.field(real, shape=(), needs_dual=True)  # FwdMode's required (unused) loss and param:
+        self.unit = ti.field(real, shape=(), needs_dual=True)  # the seeds are dx's duals, set per element
+        self.log_scale = runtime.field("ftle.log_scale", real, self.pixels)  # L
+        self.sigma = runtime.field("ftle.sigma", real, self.pixels)  # σ_t as last drawn
+        self.edge = runtime.field("ftle.barrier", ti.u8, self.pixels)
+        self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
+        self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
+        self.barrier = min(fractal.barriers(sim.masses, sim.lengths, sim.g))
+        self.edge.from_numpy(self.barrier_curve())
+        self.font = Font(self.lay.font) if self.lay.font else None
+        self.background = self.decorate()
+        self.restart()
+
+    def barrier_curve(self) -> np.ndarray:
+        """Per pixel, 1 where E < B and a 4-neighbour has E ≥ B: the barrier's curve, on its inner side."""
+        self.launch("ftle_energy")
+        inside = (self.sigma.to_numpy() < self.barrier).reshape(self.h, self.w)
+        out = np.zeros_like(inside)
+        out[1:] |= ~inside[:-1]
+        out[:-1] |= ~inside[1:]
+        out[:, 1:] |= ~inside[:, :-1]
+        out[:, :-1] |= ~inside[:, 1:]
+        return (inside & out).ravel().astype(np.uint8)
+
+    def restart(self):
+        """M = I and L = 0 at every pixel, from the system's current (initial) state."""
+        self.launch("ftle_setup")
+
+    def advance_frame(self):
+        sim = self.sim
+        self.out.dual.fill(0)  # forward mode adds into the output's duals
+        with scalarized(), ti.ad.FwdMode(loss=self.loss, param=self.unit, seed=[1.0], clear_gradients=False):
+            self.launch("ftle_frame", self.twin, sim.substeps, sim.h)
+        self.launch("ftle_renormalise")
+        sim.t += sim.substeps * sim.h
+
+    def tangents(self) -> tuple[np.ndarray, np.ndarray]:
+        """(M, L): per pixel the k×k matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
+        m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
+        return m, self.log_scale.to_numpy().astype(np.float64)
+
+    def summary(self) -> dict:
+        """For metadata.json: the plot, the lattice, σ's spread and how many pixels are trusted."""
+        sig, until = self.sigma.to_numpy(), self.until.to_numpy()
+        trusted = np.float32(self.sim.t) <= until
+        lay, stride = self.lay, self.scene.map.trust_stride
+        q = np.percentile(sig, [5, 50, 95]).tolist() if self.sim.t > 0 else [0.0] * 3
+        return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "pixels": self.pixels, "sigma_scale_per_s": [self.lo, self.hi],
+                "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
+                            * len(grid.lattice_axis(lay.h, stride))},
+                "t_s": self.sim.t, "sigma_percentiles_5_50_95_per_s": q, "trusted": int(trusted.sum()),
+                "barrier_pixels": int(self.edge.to_numpy().sum())}
+
+    # ------------------------------------------------------------ kernels
+    @ti.kernel
+    def ftle_energy(self):
+        """Each pixel's energy, into sigma for now (barrier_curve reads it once)."""
+        for p in range(self.pixels):
+            self.sigma[p] = self.sim.energy(self.sim.q[p], self.sim.v[p])
+
+    @ti.kernel
+    def ftle_setup(self):
+        for e in range(self.k * self.pixels):
+            self.dx[e] = ti.Vector.zero(float, self.k)
+            self.dx.dual[e] = ti.Vector.unit(self.k, e % self.k, float)
+        for p in range(self.pixels):
+            self.log_scale[p], self.sigma[p] = 0.0, 0.0
+
+    @ti.kernel
+    def ftle_frame(self, sys: ti.template(), substeps: ti.i32, h: float):
+        """One frame of every pixel, four times: lane e % k with column e % k of its M as the state's dual."""
+        D = ti.static(self.sim.D)
+        for e in range(self.k * self.pixels):
+            p, d = e // self.k, self.dx[e]
+            q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
+            v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
+            for _ in range(substeps):
+                q, v = integrators.step(sys, q, v, h)
+            self.out[e] = ti.Vector([q[c, 0] for c in ti.static(range(D))] + [v[c, 0] for c in ti.static(range(D))])
+
+    @ti.kernel
+    def ftle_renormalise(self):
+        """The new state (lane 0's primal), M = the frame's images over their largest entry m, L += ln m."""
+        D, K = ti.static(self.sim.D, self.k)
+        for p in range(self.pixels):
+            m = 0.0
+            for k in ti.static(range(K)):
+                m = ti.max(m, ti.abs(self.out.dual[K * p + k]).max())
+            ok = m > 0.0 and m < 1e30  # also NaN
+            if ok:
+                for k in ti.static(range(K)):
+                    self.dx.dual[K * p + k] = self.out.dual[K * p + k] / m
+                self.log_scale[p] += ti.log(m)
+            x = self.out[K * p]
+            self.sim.q[p] = ti.Vector([x[c] for c in ti.static(range(D))])
+            self.sim.v[p] = ti.Vector([x[D + c] for c in ti.static(range(D))])
+            if not (ok and ti.abs(x).max() < 1e30):
+                ti.atomic_min(self.sim.bad[None], p)
+
+    @ti.func
+    def log_smax(self, p):
+        """ln s_max(M) of pixel p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
+        K = ti.static(self.k)
+        m = ti.Matrix.cols([self.dx.dual[K * p + k] for k in ti.static(range(K))])
+        b = m.transpose() @ m
+        c = b
+        for _ in range(SQUARINGS):
+            c = c @ c
+            c /= ti.abs(c).max()
+        best, x = 0.0, ti.Vector.zero(float, K)
+        for k in ti.static(range(K)):
+            n = c[:, k].norm_sqr()
+            if n > best:
+                best, x = n, c[:, k]
+        return 0.5 * ti.log(x.dot(b @ x) / x.norm_sqr())
+
+    @ti.func
+    def bar_colour(self, u):
+        """The colour bar's colour at u in [0, 1] (bottom to top): σ = u·SIGMA_MAX."""
+        return fractal.palette(u)
+
+    @ti.kernel
+    def ftle_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
+        """σ_t of every pixel, on the linear scale; the barrier's curve black; past the faithful time, masked."""
+        for r, c in ti.ndrange(self.h, self.w):
+            p = r * self.w + c
+            s = 0.0
+            if t > 0.0:
+                s = (self.log_scale[p] + self.log_smax(p)) / t
+            self.sigma[p] = s
+            col = fractal.palette(s / SIGMA_MAX)
+            if self.edge[p]:
+                col = ti.Vector([0.0, 0.0, 0.0])
+            if t > self.until[p]:
+                col = fractal.untrusted(col, c, r)
+            for k in ti.static(range(3)):
+                out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)

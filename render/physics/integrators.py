@@ -1,0 +1,185 @@
+"""The integration methods, each written once, and the step size that keeps them stable.
+
+A method works on any system: it needs only the system's `force(q, v)` (and, for the implicit midpoint, its
+canonical hooks `momenta`, `velocities`, `momentum_rate` and `p_scale`). States are "lane matrices": row k is
+coordinate k, column l is pendulum l of a group (see System.advance), so a method is plain matrix arithmetic.
+The method is chosen at compile time with ti.static, so a run compiles only the one it uses.
+"""
+import math
+
+import taichi as ti
+
+from ..errors import SceneError
+
+DEFAULT_MAX_DRIFT = 0.05  # the energy watchdog's tolerance unless a scene sets integrator.max_drift
+
+# dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
+# implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
+# rk2's 2 is its limit on the real axis (a decaying mode: |1 + z + z²/2| <= 1 for z in [-2, 0]). On the
+# imaginary axis no explicit two-stage method is stable at any step: an undamped oscillation grows by
+# |1 + iy - y²/2| = sqrt(1 + y⁴/4), about 1 + y⁴/8 per step for y = h·ω, i.e. 2e-4 per step at "auto"'s
+# y = 0.2 on the fastest mode the bound allows, 2e-7 on rigid_chaos at dt = 1e-3 (y = 0.034). The energy
+# watchdog stops a run where that growth shows.
+STABILITY = {"symplectic_euler": 2.0, "verlet": 2.0, "rk2": 2.0, "rk4": 2.785, "yoshida4": 1.573,
+             "implicit_midpoint": 1.0}
+ORDER = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 4, "implicit_midpoint": 2}
+# Where a method gains energy run-long, by the coordinates the system steps (its reference model): symplectic
+# Euler is symplectic on Cartesian springs (constant masses: v is a momentum up to them), not on a chain's
+# (θ, ω), whose mass matrix depends on θ; RK2 gains on every oscillation (|R(iy)|² = 1 + y⁴/4). There the step
+# must also keep the gain within max_drift over the run (render/physics/stability.py's energy_limit). The others keep
+# energy bounded (Verlet and Yoshida on springs, the implicit midpoint stepping canonical (q, p) everywhere),
+# or only lose it at a stable step (RK4: |R(iy)| < 1 for y < 2.83), which leaves the stability bound's
+# premise, E ≤ E_max·(1 + max_drift), intact; the watchdog still stops a loss beyond max_drift.
+ENERGY_GAIN = {"symplectic_euler": ("chain",), "rk2": ("chain", "springs")}
+# On a linear oscillator a method that gains energy gains c·y^k of it per step (y = h·ω): (c, k). Springs are
+# linear in their stretch, so this bounds RK2's gain there from the fastest mode (stability.oscillator_limit).
+OSCILLATOR_GAIN = {"rk2": (0.25, 4)}
+SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
+AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
+
+# Yoshida's 4th-order composition of three velocity-Verlet steps.
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
+YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
+
+
+def gains_energy(method: str, model: str) -> bool:
+    """Whether `method` gains energy run-long on a system of this reference model ("chain" | "springs")."""
+    return model in ENERGY_GAIN.get(method, ())
+
+
+def step_limit(scene, omega_max: float, energy_limit: float = math.inf) -> float:
+    """The longest step the scene's method is offered at: its stability limit over the rate, damping added,
+    and no longer than `energy_limit` (the step that keeps its energy gain within max_drift: System.energy_limit).
+
+    Viscous damping c adds a decaying mode of rate c, which limits explicit methods on the real axis as an
+    oscillation of rate ω does on the imaginary one; adding the two is a simple, safe bound."""
+    return min(stability_limit(scene, omega_max), energy_limit)
+
+
+def stability_limit(scene, omega_max: float) -> float:
+    damping = scene.pendulums.damping if scene.has("damping") else 0.0
+    rate = omega_max + damping
+    if not math.isfinite(rate):
+        raise SceneError(f"{scene.source}: pendulums: the scene's fastest rate is not finite (omega_max = "
+                         f"{omega_max}): its values are beyond what f64 arithmetic can step")
+    return STABILITY[scene.integrator.method] / rate if rate > 0 else math.inf  # at rest without gravity
+
+
+SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
+
+
+def check_substeps(scene, substeps: int, h: float) -> None:
+    """Refuse substeps per frame beyond the kernel's i32 counter: beyond it the count wrapped to 0 and the video
+    froze (render/config/budget.py refuses long runs by their time)."""
+    if substeps > SUBSTEP_LIMIT:
+        raise SceneError(f"{scene.source}: integrator.dt: dt too small: {substeps} substeps per frame of {h:.3g} s "
+                         f"exceed the step counter's limit of {SUBSTEP_LIMIT}; use a larger integrator.dt")
+
+
+def timestep(scene, omega_max: float, energy_limit: float = math.inf) -> tuple[float, int]:
+    """(step h, substeps per frame). h = frame time / substeps, never longer than the requested dt."""
+    frame_dt = 1.0 / scene.video.fps
+    method, dt = scene.integrator.method, scene.integrator.dt
+    limit = stability_limit(scene, omega_max)
+    if dt == "auto":
+        dt = min(AUTO_DT, SAFETY * limit, energy_limit)  # the energy limit is itself an accuracy bound
+    elif dt > energy_limit and dt <= limit and not scene.integrator.allow_unstable:
+        drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
+        raise SceneError(
+            f"{scene.source}: integrator.dt: {dt:g} s is beyond the energy limit of {method} for this scene: it is "
+            f"not symplectic on these coordinates, and pilot steps from the scene's hardest states say its energy "
+            f"could drift past integrator.max_drift = {drift:g} within the {scene.video.duration:g} s, "
+            f"so dt < {energy_limit:.3g} s; use integrator.dt = \"auto\", a smaller dt or a symplectic method, "
+            f"or set integrator.allow_unstable = true to proceed anyway")
+    elif dt > limit and not scene.integrator.allow_unstable:
+        damping = scene.pendulums.damping if scene.has("damping") else 0.0
+        with_damping = f" + damping {damping:g} 1/s" if damping else ""
+        raise SceneError(
+            f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
+            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s{with_damping}, "
+            f"so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
+            f"or set integrator.allow_unstable = true to proceed anyway")
+    substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
+    return frame_dt / substeps, substeps
+
+
+@ti.func
+def step(sys: ti.template(), q, v, h):
+    """One step of sys.method from (q, v)."""
+    if ti.static(sys.method == "symplectic_euler"):
+        q, v = symplectic_euler(sys, q, v, h)
+    elif ti.static(sys.method == "verlet"):
+        q, v = verlet(sys, q, v, h)
+    elif ti.static(sys.method == "yoshida4"):
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W0 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+    elif ti.static(sys.method == "rk2"):
+        q, v = rk2(sys, q, v, h)
+    elif ti.static(sys.method == "rk4"):
+        q, v = rk4(sys, q, v, h)
+    elif ti.static(sys.method == "implicit_midpoint"):
+        q, v = implicit_midpoint(sys, q, v, h)
+    return q, v
+
+
+@ti.func
+def symplectic_euler(sys: ti.template(), q, v, h):
+    """The seed's v += a·h; x += v·h. Symplectic for a separable system (springs) only: on the rigid chain
+    (θ, ω) are not canonical, so its energy error grows slowly (see docs/accuracy.md)."""
+    v += h * sys.force(q, v)
+    return q + h * v, v
+
+
+@ti.func
+def verlet(sys: ti.template(), q, v, h):
+    v += 0.5 * h * sys.force(q, v)
+    q += h * v
+    return q, v + 0.5 * h * sys.force(q, v)
+
+
+@ti.func
+def rk2(sys: ti.template(), q, v, h):
+    """The explicit midpoint rule: a half step of Euler, then the full step with the midpoint's slopes.
+    Two force evaluations per step, second order; between symplectic Euler (1) and rk4 (4) at equal cost."""
+    a1 = sys.force(q, v)
+    vm = v + 0.5 * h * a1
+    return q + h * vm, v + h * sys.force(q + 0.5 * h * v, vm)
+
+
+@ti.func
+def rk4(sys: ti.template(), q, v, h):
+    a1 = sys.force(q, v)
+    q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
+    a2 = sys.force(q2, v2)
+    q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
+    a3 = sys.force(q3, v3)
+    q4, v4 = q + h * v3, v + h * a3
+    a4 = sys.force(q4, v4)
+    return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+
+
+@ti.func
+def column_norm_sqr(m):
+    """|column|² of each lane of a lane matrix."""
+    return ti.Vector([m[:, lane].norm_sqr() for lane in ti.static(range(m.get_shape()[1]))])
+
+
+@ti.func
+def implicit_midpoint(sys: ti.template(), q, v, h):
+    """The midpoint rule in canonical (q, p), solved by fixed-point iteration until every lane moves less
+    than sys.tol (at most 100 sweeps). It is symplectic only in canonical coordinates: applied to (θ, ω) of
+    a rigid chain its symplecticity defect shrinks only like h³ and energy creeps."""
+    p = sys.momenta(q, v)
+    q1, p1 = q + h * v, p + h * sys.momentum_rate(q, v, p)
+    pscale = sys.p_scale(h)
+    for _ in range(100):
+        qm, pm = 0.5 * (q + q1), 0.5 * (p + p1)
+        vm = sys.velocities(qm, pm)
+        qn, pn = q + h * vm, p + h * sys.momentum_rate(qm, vm, pm)
+        err = ti.max(column_norm_sqr(qn - q1), column_norm_sqr(pn - p1) * pscale * pscale).max()
+        q1, p1 = qn, pn
+        if err <= sys.tol * sys.tol:
+            break
+    return q1, sys.velocities(q1, p1)

@@ -1,0 +1,338 @@
+"""What every pendulum system shares: its declaration for the registry, state fields, the advance and energy
+kernels, the drawing contract and the watchdog.
+
+A system module (render/physics/systems/) subclasses System, declares what the registry and the scene loader need as
+class attributes, and writes its physics once as Taichi functions:
+- accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group of LANES), so the
+  same code runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
+- energy(q, v) and points(q) for one pendulum's vectors.
+The integrators (render/physics/integrators.py) call force(); the canvas reads only points() and the Python-side
+contract (LINKS, bob_sizes(), reach(), lengths).
+"""
+
+import math
+
+import numpy as np
+import taichi as ti
+
+from . import grid, integrators, keys, poincare, runtime
+from .sincos import sincos
+from ..errors import SimulationError
+
+DEFAULT_MAX_DRIFT = integrators.DEFAULT_MAX_DRIFT  # the energy watchdog's tolerance unless a scene sets one
+BLOWN = 100.0  # a relative energy drift this large is a blow-up, not a drift
+
+
+class System(runtime.Launcher):
+    """Base of @ti.data_oriented systems."""
+
+    # ---- the declaration (class attributes: read without a Taichi runtime) ----
+    SYSTEM = ""  # the preset's `system` value
+    NAME = ""  # prefix of this system's kernel names in metadata ("rigid_advance")
+    DOC = ""  # one line for `pendulum presets` and docs/presets.md
+    D = 0  # coordinates per pendulum in q (and v)
+    LINKS: tuple[str, ...] = ()  # drawing contract: what joins pivot→bob 1→bob 2...: "rod" | "spring"
+    ANGLES = False  # q holds the links' angles (a fractal can colour by them)
+    KEYS: dict = {}  # preset keys under [pendulums] beyond the chain's (keys.chain) and the common ones
+    METHODS: tuple[str, ...] = ()  # integrators this system supports
+    DEFAULT_EFFECTS: tuple[str, ...] = ()
+    STATE: dict = {}  # `simulate`'s arrays: name -> ("q" | "v", shape per pendulum)
+    REFERENCE = ""  # the independent model in render/physics/reference.py ("chain" | "springs")
+    ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
+    ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
+    ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
+    LANES = 1  # pendulums per lane matrix (the columns integrators.step sees)
+    CHUNK = 16  # pendulums per group of the advance kernel in f64; f32 takes twice as many (see advance)
+
+    @classmethod
+    def preset_keys(cls) -> dict:
+        return keys.chain(len(cls.LINKS), cls.KEYS)
+
+    # ---- one instance per run ----
+    def __init__(self, scene, subset=None, allocate: bool = True):
+        """The scene's pendulums, or only those at the indices `subset` (the step is the whole scene's).
+        Without `allocate` it only plans: the initial state and the step, no Taichi field."""
+        self.scene = scene
+        p = scene.pendulums
+        self.count = p.count
+        self.method = scene.integrator.method
+        self.libm = scene.integrator.trig == "libm"
+        self.damped = scene.has("damping")
+        self.damping = p.damping
+        self.poincare = scene.has("poincare")  # crossings of the section recorded per substep (render/physics/poincare.py)
+        self.g = p.gravity
+        self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
+        q0, v0 = self.initial_state()
+        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
+                                                     self.energy_limit(q0, v0, self.method))
+        integrators.check_substeps(scene, self.substeps, self.h)  # "auto" is known only now: before any work
+        if subset is not None:
+            q0, v0 = q0[subset], v0[subset]
+        self.n, self.subset = len(q0), subset
+        if not allocate:
+            return
+        self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
+        real = runtime.real()
+        self.chunk = self.CHUNK * (2 if real == ti.f32 else 1)  # 4 vector registers of lanes either way
+        self.groups = -(-self.n // self.chunk)
+        self.q = runtime.field("state.q", real, self.n, self.D)
+        self.v = runtime.field("state.v", real, self.n, self.D)
+        self.bad = runtime.field("watchdog.bad", ti.i32, ())
+        if self.poincare:
+            poincare.allocate(self)
+        self.load(q0, v0)
+        if scene.has("energy"):
+            self.floor = self.energy_floor()
+            self.e = runtime.field("energy.e", real, self.n)
+            self.e0 = runtime.field("energy.e0", real, self.n)
+            self.escale = runtime.field("energy.scale", real, self.n)
+            self.drift = runtime.field("energy.max_drift", real, ())
+
+    def load(self, q0: np.ndarray, v0: np.ndarray):
+        """Set the state (and the clock and the watchdog) to t = 0."""
+        dtype = np.float64 if runtime.real() == ti.f64 else np.float32
+        self.q.from_numpy(q0.astype(dtype))
+        self.v.from_numpy(v0.astype(dtype))
+        self.bad[None] = self.n
+        if self.poincare:
+            self.crossed.fill(0)
+        self.t = 0.0
+
+    def restart(self):
+        """Back to the initial state, as first built: the same frames follow again."""
+        q0, v0 = self.initial_state()
+        if self.subset is not None:
+            q0, v0 = q0[self.subset], v0[self.subset]
+        self.load(q0, v0)
+
+    def kernel(self, name: str):
+        """Kernels are logged under the system's prefix ("rigid_advance") and shared by every system."""
+        return {"advance": self.advance_by, "energy": self.energies}[name.removeprefix(f"{self.NAME}_")]
+
+    def advance_by(self, substeps: int, h: float | None = None):
+        """`substeps` steps of h (default: the scene's step)."""
+        (self.advance_libm if self.libm else self.advance)(substeps, self.h if h is None else h)
+
+    # --------------------------------------------------------------- per-system parts (Python)
+    def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
+        """A bound (rad/s) on the fastest rate of the undamped linearised dynamics over the whole run from these
+        initial states: the step limit is the method's limit over it plus the damping rate (integrators.timestep,
+        render/physics/stability.py)."""
+        raise NotImplementedError
+
+    def energy_limit(self, q0: np.ndarray, v0: np.ndarray, method: str) -> float:
+        """The longest step (s) at which `method` keeps the energy gain of the whole run from these initial
+        states within integrator.max_drift, where it gains energy on this system (integrators.ENERGY_GAIN);
+        inf where it does not."""
+        return math.inf
+
+    def deviation(self, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
+        """How far apart two states are, per pendulum, in the unit of integrator.tolerance: rad on any angle."""
+        return np.abs(qa - qb).max(-1)
+
+    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    def reach(self) -> float:
+        """How far from the pivot a bob can get, in m: the canvas frames the scene by it."""
+        raise NotImplementedError
+
+    def bob_sizes(self) -> tuple[float, ...]:
+        """Each bob's radius relative to the largest (as the cube root of its mass)."""
+        top = max(self.masses)
+        return tuple((m / top) ** (1 / 3) for m in self.masses)
+
+    def initial_angles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per pendulum, the angle and rate of every link, each (N, links).
+
+        A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]², one
+        per pixel of the map's plot (render/physics/grid.py)."""
+        p, n, links = self.scene.pendulums, self.count, len(self.LINKS)
+        th = np.array([[p[f"theta{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
+        w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
+        if p.layout == "grid":
+            th, w = grid.grid_state(self.scene, th, w)
+        elif p.layout == "shell":
+            poincare.shell_start(self.scene, th, w)
+        else:
+            th[:, -1] = th[:, -1] - p.spread * np.arange(n, dtype=np.float64) / n
+        return th, w
+
+    # --------------------------------------------------------------- per-system parts (Taichi)
+    @ti.func
+    def accel(self, q, v):
+        """Accelerations for lane matrices q, v (D × LANES)."""
+        raise NotImplementedError
+
+    @ti.func
+    def energy(self, q, v):
+        """Total energy of one pendulum, zero at the hanging rest position."""
+        raise NotImplementedError
+
+    @ti.func
+    def points(self, q):
+        """The bobs of one pendulum as a (links × 2) matrix of positions in m, the pivot at the origin."""
+        raise NotImplementedError
+
+    # Canonical hooks for the implicit midpoint: a separable system with constant masses may take p = v.
+    @ti.func
+    def momenta(self, q, v):
+        return v
+
+    @ti.func
+    def velocities(self, q, p):
+        return p
+
+    @ti.func
+    def momentum_rate(self, q, v, p):
+        return self.force(q, v)
+
+    @ti.func
+    def p_scale(self, h):
+        """Converts a change of momentum into a change of position over a step, for the solver's tolerance."""
+        return h
+
+    # --------------------------------------------------------------- shared Taichi parts
+    @ti.func
+    def sincos(self, x):
+        """(sin x, cos x) for accel: inline (render/physics/sincos.py) unless the scene asks for libm's exact bits."""
+        if ti.static(self.libm):
+            return ti.sin(x), ti.cos(x)
+        else:
+            return sincos(x)
+
+    @ti.func
+    def lane_force(self, q, v):
+        a = self.accel(q, v)
+        if ti.static(self.damped):
+            a -= self.damping * v
+        return a
+
+    @ti.func
+    def force(self, q, v):
+        """Accelerations with damping, for lane matrices or for one pendulum's vectors."""
+        if ti.static(len(q.get_shape()) == 1):
+            return self.lane_force(ti.Matrix.cols([q]), ti.Matrix.cols([v]))[:, 0]
+        else:
+            return self.lane_force(q, v)
+
+    @ti.kernel
+    def advance(self, substeps: ti.i32, h: float):
+        """All pendulums `substeps` steps of h on, in groups of `chunk`: the state stays in registers and on the
+        stack for the whole frame, and is read and written once.
+
+        Each group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
+        stack array rather than chunk·D scalars), and each substep is a loop over those columns that steps one
+        pendulum (a D × 1 lane matrix) at a time. With no call and no branch on values in the step, LLVM's
+        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction: that loop is the SIMD. Every
+        pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
+        at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
+        B = ti.static(self.chunk)
+        for g in range(self.groups):
+            Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
+            for lane in range(B):
+                i = ti.min(g * B + lane, self.n - 1)
+                Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+            Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
+            if ti.static(self.poincare):
+                for lane in range(B):
+                    if g * B + lane < self.n:
+                        self.crossed[g * B + lane] = 0
+            for s in range(substeps):
+                if ti.static(self.poincare):
+                    Q0, V0 = Q, V
+                for lane in range(B):  # the loop LLVM vectorises
+                    q, v = integrators.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                    Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                if ti.static(self.poincare):  # in a loop of its own, so that its branch leaves the step's SIMD
+                    for lane in range(B):
+                        poincare.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                                        ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
+                                        ti.Matrix.cols([V[:, lane]]), h)
+            for lane in range(B):
+                i = g * B + lane
+                if i < self.n:
+                    self.q[i], self.v[i] = Q[:, lane], V[:, lane]
+                    if not (ti.abs(Q[:, lane]).max() < 1e30 and ti.abs(V[:, lane]).max() < 1e30):  # also NaN
+                        ti.atomic_min(self.bad[None], i)
+
+    @ti.kernel
+    def advance_libm(self, substeps: ti.i32, h: float):
+        """advance for scenes that pin libm's sin/cos: one pendulum per iteration, as before the chunks (libm
+        calls do not vectorise), so its results are the earlier releases' to the bit (LLVM merges sin and cos
+        differently in the chunked loop, and in f32 from upright those bits decide the chaos)."""
+        for i in range(self.n):
+            q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
+            if ti.static(self.poincare):
+                self.crossed[i] = 0
+            for s in range(substeps):
+                q0, v0 = q, v
+                q, v = integrators.step(self, q, v, h)
+                if ti.static(self.poincare):
+                    poincare.detect(self, i, s, q0, v0, q, v, h)
+            self.q[i], self.v[i] = q[:, 0], v[:, 0]
+            if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
+                ti.atomic_min(self.bad[None], i)
+
+    @ti.kernel
+    def energies(self, first: ti.i32):
+        for i in range(self.n):
+            self.energy_one(i, first)
+
+    @ti.func
+    def energy_one(self, i: ti.i32, first: ti.i32):
+        e = self.energy(self.q[i], self.v[i])
+        self.e[i] = e
+        if first:
+            self.e0[i] = e
+            self.escale[i] = ti.max(ti.abs(e), self.floor)
+        d = (e - self.e0[i]) / self.escale[i]
+        if ti.static(self.damped):
+            d = ti.max(d, 0.0)  # damping may only remove energy; a gain is the error
+        ti.atomic_max(self.drift[None], ti.abs(d))
+        if not ti.abs(d) < 1e30:
+            ti.atomic_min(self.bad[None], i)
+
+    def energy_floor(self) -> float:
+        """Energy scale for pendulums whose own energy is near zero."""
+        return 1e-3 * sum(self.masses) * max(self.g, 1.0) * sum(self.lengths)
+
+    # --------------------------------------------------------------- host side
+    def advance_frame(self):
+        self.launch(f"{self.NAME}_advance", self.substeps)
+        self.t += self.substeps * self.h
+
+    def measure_energy(self, first: bool = False):
+        """Energies at this frame into self.e, and the max relative drift so far into self.drift."""
+        if first:
+            self.drift[None] = 0.0
+        self.launch(f"{self.NAME}_energy", int(first))
+
+    def check(self, frame: int, max_drift: float | None):
+        """Watchdog, once per frame: NaN/inf anywhere, or energy drift beyond the tolerance."""
+        bad = int(self.bad[None])
+        if bad < self.n:
+            raise self.blew_up(frame, self.t, bad, "NaN/inf")
+        if max_drift is not None and self.scene.has("energy"):
+            drift = float(self.drift[None])
+            if drift > max_drift:
+                d = (self.e.to_numpy() - self.e0.to_numpy()) / self.escale.to_numpy()
+                worst = int(np.argmax(d if self.damped else np.abs(d)))  # damped: only a gain is the error
+                if d[worst] >= BLOWN:
+                    raise self.blew_up(frame, self.t, worst, f"energy up {d[worst]:.3g}x its start's")
+                raise SimulationError(
+                    f"{self.scene.name}: frame {frame} (t={self.t:.4g} s): pendulum {worst}: relative energy drift "
+                    f"{100 * d[worst]:+.3g} % ({'gained' if d[worst] > 0 else 'lost'}) exceeds integrator.max_drift "
+                    f"= {max_drift:g} ({self.method}, dt={self.h:.3g} s); try a smaller integrator.dt, "
+                    f"--quality high, or a symplectic method")
+
+    def blew_up(self, frame: int, t: float, pendulum: int, what: str) -> SimulationError:
+        """The error of a run that blew up (the watchdog's, or the certificate's run: render/trust/certify.py)."""
+        return SimulationError(f"{self.scene.name}: frame {frame} (t={t:.4g} s): blew up at t={t:.4g} s "
+                               f"(pendulum {pendulum}: {what}; {self.method}, dt={self.h:.3g} s); use a smaller "
+                               f"integrator.dt (\"auto\" keeps to the step limit)")
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The arrays `simulate` writes for this frame, as STATE declares them."""
+        return {name: getattr(self, src).to_numpy().reshape(self.n, *shape)
+                for name, (src, shape) in self.STATE.items()}

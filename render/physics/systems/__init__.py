@@ -1,0 +1,1 @@
+"""One module per pendulum system; each defines SYSTEM, its System subclass (see render/physics/registry.py)."""

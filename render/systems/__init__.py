@@ -1,1 +1,0 @@
-"""One module per pendulum system; each defines SYSTEM, its System subclass (see render/registry.py)."""

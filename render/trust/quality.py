@@ -1,0 +1,164 @@
+"""--quality LEVEL: a guarantee on the scene rendered, met by the cheapest integrator that pilot runs show meets it.
+
+draft, standard and high ask that the median pendulum stay faithful (render/trust/certify.py) for 50 %, 75 % and
+100 % of the video at integrator.tolerance. Candidates are every method the system offers, in f32 and f64,
+at each step of LADDER that is stable for this scene; each costs its force evaluations per simulated second
+(f32 at half weight: it runs about twice as fast in SIMD lanes). Per method and precision, a bisection over
+the steps (faithful time grows as the step shrinks, down to round-off) finds the coarsest step that meets the
+target, each try a pilot run of PILOT pendulums of the fan against one fine reference (RK4, f64, half the
+finest step) that stops as soon as the outcome is known; the cheapest setting found is chosen. When none does, the most faithful is taken and the
+render says so. reference is the finest setting, whatever it costs.
+"""
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+
+from . import certify
+from ..physics import integrators, registry, runtime
+from ..errors import SceneError
+
+LEVELS = ("draft", "standard", "high", "reference")
+TARGET = {"draft": 0.5, "standard": 0.75, "high": 1.0}  # of the duration, for the median pendulum
+LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)  # steps tried, besides one step per frame
+EVALS = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 6, "implicit_midpoint": 8}  # per step
+PILOT = 16  # pendulums of the fan the pilots run on
+
+
+def check_level(level: str, src: str = "--quality"):
+    if level not in LEVELS:
+        raise SceneError(f"{src}: --quality: unknown level {level!r}; choose from {', '.join(LEVELS)}")
+
+
+def setting(method: str, dt: float, precision: str) -> dict:
+    return {"method": method, "dt": dt, "precision": precision}
+
+
+def cost(s: dict, fps: int) -> float:
+    """Force evaluations per simulated second, f32 at half weight."""
+    steps = math.ceil(1.0 / (fps * s["dt"]) - 1e-9) * fps
+    return EVALS[s["method"]] * steps * (0.5 if s["precision"] == "f32" else 1.0)
+
+
+def offered(scene, plan) -> list[dict]:
+    """candidates() for the scene's planned System (allocate=False): its rate bound and each method's energy
+    limit, from its own initial states."""
+    q0, v0 = plan.initial_state()
+    return candidates(scene, plan.omega_max(q0, v0), {m: plan.energy_limit(q0, v0, m) for m in plan.METHODS})
+
+
+def candidates(scene, rate: float, energy: dict) -> list[dict]:
+    """Every stable (method, dt, precision) the system offers, cheapest first; `energy` holds each method's
+    energy limit (System.energy_limit)."""
+    frame = 1.0 / scene.video.fps
+    limit = {m: integrators.step_limit(_with(scene, setting(m, frame, "f64")), rate, energy[m])
+             for m in registry.get(scene.system).METHODS}
+    out = [setting(m, dt, p) for m in limit for p in ("f32", "f64")
+           for dt in (frame, *(d for d in LADDER if d < frame)) if dt < limit[m]]
+    return sorted(out, key=lambda s: (cost(s, scene.video.fps), s["precision"] == "f32"))
+
+
+def choose(scene, arch: str = "cpu", threads=None):
+    """The scene with the integrator its quality level calls for, and a report of the choice."""
+    level = scene.quality
+    if level is None:
+        return scene, {"level": None, "chosen": _as_dict(scene.integrator), "why": "the preset's own settings"}
+    cls = registry.get(scene.system)
+    plan = cls(scene, allocate=False)
+    cands = offered(scene, plan)
+    if not cands:
+        raise SceneError(f"{scene.source}: --quality {level}: no integrator is stable for this scene at the steps "
+                         f"tried ({', '.join(f'{d:g}' for d in LADDER)} s)")
+    if level == "reference":
+        best = min(cands, key=lambda s: (s["precision"] != "f64", s["dt"], -integrators.ORDER[s["method"]]))
+        return _with(scene, best), {"level": level, "chosen": best, "why": "the finest step in f64, whatever it costs"}
+    duration = scene.video.duration
+    need = TARGET[level] * duration
+    pilot = Pilot(scene, arch, threads, min(s["dt"] for s in cands) / 2, need)
+    fps, tried, chosen = scene.video.fps, [], None
+
+    def meets(s: dict) -> bool:
+        median = pilot.median_until(s, need)
+        tried.append({**s, "cost": cost(s, fps), "median_until_s": median})
+        return median >= need
+
+    for prec in ("f64", "f32"):  # one Taichi runtime per precision: all f64 pilots first
+        for method in registry.get(scene.system).METHODS:
+            # Faithful time grows as the step shrinks (until round-off): bisect for the coarsest step that
+            # meets the target, among those cheaper than the choice so far.
+            ladder = [s for s in cands if (s["method"], s["precision"]) == (method, prec)
+                      and (chosen is None or cost(s, fps) < cost(chosen, fps))]
+            lo, hi = 0, len(ladder)  # ladder[hi:] meet the target (hi = len: none known to)
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if meets(ladder[mid]):
+                    hi = mid
+                else:
+                    lo = mid + 1
+            if hi < len(ladder):
+                chosen = ladder[hi]
+    report = {"level": level, "target": f"median pendulum faithful for {100 * TARGET[level]:.0f} % of the "
+                                         f"{duration:g} s at {scene.integrator.tolerance:g}",
+              "pilots": {"pendulums": len(pilot.indices), "tried": tried}}
+    if chosen is None:
+        best = max(tried, key=lambda r: (r["median_until_s"], -r["cost"]))
+        chosen = {k: best[k] for k in ("method", "dt", "precision")}
+        print(f"pendulum: --quality {level}: no setting keeps the median pendulum faithful for "
+              f"{100 * TARGET[level]:.0f} % of {duration:g} s; using the most faithful, {_name(chosen)} "
+              f"(median {best['median_until_s']:.2f} s in pilot runs)", file=sys.stderr)
+        report.update(met=False, why="no candidate met the target: the most faithful one")
+    else:
+        report.update(met=True, why=f"the cheapest of {len(cands)} stable candidates that meets the target, "
+                                    f"found by bisection in {len(tried)} pilot runs")
+    report["chosen"] = chosen
+    return _with(scene, chosen), report
+
+
+class Pilot:
+    """PILOT pendulums of the scene against one fine reference, re-run for each candidate setting."""
+
+    def __init__(self, scene, arch, threads, ref_dt: float, need: float):
+        self.scene, self.arch, self.threads = scene, arch, threads
+        self.indices = certify.subsample(scene.pendulums.count, PILOT)
+        ref = _with(scene, setting("rk4", ref_dt, "f64"))
+        # As far as the target needs: a pilot's outcome is known there.
+        self.frames = min(scene.frames, math.ceil(need * scene.video.fps) + 2)
+        self.ref, _ = certify.trajectory(ref, self.indices, arch, threads, self.frames)
+        self.systems = {}
+
+    def median_until(self, s: dict, need: float) -> float:
+        """The median pendulum's faithful time under setting s, run only as far as it takes to know."""
+        scene = _with(self.scene, s)
+        runtime.init(self.arch, s["precision"], self.threads)
+        key = (s["method"], s["precision"])
+        if key not in self.systems or self.systems[key][0] != runtime.generation():  # one compile per method
+            self.systems[key] = (runtime.generation(), registry.get(scene.system)(scene, subset=self.indices))
+        sim = self.systems[key][1]
+        sim.restart()
+        fps, tol = scene.video.fps, scene.integrator.tolerance
+        substeps = math.ceil(1.0 / (fps * s["dt"]) - 1e-9)
+        h = 1.0 / (fps * substeps)
+        until = np.full(len(self.indices), scene.video.duration)
+        half = len(self.indices) // 2
+        for f in range(1, self.frames):
+            sim.advance_by(substeps, h)
+            err = certify.MARGIN * sim.deviation(sim.q.to_numpy(), self.ref[f]) / tol
+            fresh = (until >= scene.video.duration) & ~(err <= 1.0)  # NaN counts as broken
+            until[fresh] = (f - 1) / fps
+            if np.sum(until < scene.video.duration) > half and f / fps <= need:
+                break  # the median has broken before the target: no need to run on
+        return float(np.median(until))
+
+
+def _with(scene, s: dict):
+    return scene.replace(integrator={**s, "allow_unstable": False})
+
+
+def _as_dict(integ) -> dict:
+    return {"method": integ.method, "dt": integ.dt, "precision": integ.precision}
+
+
+def _name(s: dict) -> str:
+    return f"{s['method']} dt={s['dt']:.3g} {s['precision']}"

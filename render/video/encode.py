@@ -1,0 +1,281 @@
+"""Stream raw frames into the ffmpeg bundled with imageio-ffmpeg: MP4 and GIF from one pass.
+
+Each format has its own ffmpeg process writing to a hidden temporary file beside the final one; close()
+renames them into place only when every process succeeded, abort() removes them.
+
+Pipelining: each ffmpeg process has its own writer thread fed from its own small bounded queue, so
+simulating and drawing the next frames overlaps with encoding the previous ones, a slow GIF never stalls the
+MP4 (or the other way round), and memory stays flat (the queues share the frame arrays, they do not copy
+them). The pipes are enlarged so a writer hands over a frame in a few system calls.
+"""
+from __future__ import annotations
+
+import errno
+import math
+import os
+import queue
+import subprocess
+import tempfile
+import threading
+import time
+from fractions import Fraction
+from pathlib import Path
+
+import imageio_ffmpeg
+import numpy as np
+
+from .atomic import publish, temp_beside
+from ..errors import EncodeError
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: default pipe sizes
+    fcntl = None
+
+QUEUE_FRAMES = 6  # per ffmpeg process: at most ~14 distinct 720p frames (2.8 MB each) are ever waiting
+PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe (/proc/sys/fs/pipe-max-size)
+F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call fails harmlessly
+
+
+# Chosen on rigid_chaos (20 s, 1280x720, 60 fps), every setting encoding the same raw frames:
+# - MP4: veryfast at crf 31 is 11.5 MB (crf 20 was 36 MB); crf is the only lever that matters here. Near that
+#   size "fast" gains 0.2-0.4 dB PSNR but made the whole render 2x slower on 2 cores (the render waits on
+#   the encoder); "medium" costs 2x "veryfast" for 0.4 dB. tune=animation, aq-mode=3, weightp=2, a longer
+#   GOP and smaller deadzones did not beat plain crf at equal size.
+# - GIF: the trails fade every frame, so nearly every lit pixel changes in every frame and dithering is not
+#   what makes the file big; pixels x frames x palette size is. 352 px (area-averaged: no lanczos ringing
+#   around thin lines) x 20 fps x 64 colours makes 4.6 MB (480 px x 25 fps x 256 colours was 14.7 MB) and
+#   a third of the CPU. Bayer dithering costs nothing here and keeps the fractal's gradients from banding.
+MP4_PRESET, MP4_CRF = "veryfast", "31"
+GIF_COLOURS = 64
+
+
+def mp4_args(video) -> list[str]:
+    return ["-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
+            "-movflags", "+faststart", "-f", "mp4"]
+
+
+def gif_args(video) -> list[str]:
+    width = min(video.gif_width, video.width)  # downscale only: a small video keeps its own size
+    graph = (f"scale={width}:-2:flags=area,split[a][b];"
+             f"[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
+             f"[b][p]paletteuse=dither=bayer:bayer_scale=3")
+    return ["-vf", graph, "-loop", "0", "-f", "gif"]
+
+
+def gif_rate(video) -> int:
+    return min(video.gif_fps, video.fps)
+
+
+def _near(x: Fraction) -> int:
+    return math.floor(x + Fraction(1, 2))  # ffmpeg's AV_ROUND_NEAR_INF, for x >= 0
+
+
+def gif_repeats(video, frames: int) -> list[int]:
+    """How many GIF frames each video frame becomes (mostly 0 or 1): the GIF's frames are picked here and only
+    those are piped, instead of every frame for ffmpeg's fps filter to drop (2/3 of the pipe at 60 -> 20 fps).
+    The picks are that filter's (eof_action=pass): GIF frame k shows the last video frame whose time, rounded
+    to the GIF's clock, is at most k, for k < ceil(frames·gif/fps); so the GIF is byte-identical to the one the
+    filter made (checked against ffmpeg for 585 rate and length pairs: tests/test_render.py)."""
+    r = Fraction(gif_rate(video), video.fps)
+    slots = math.ceil(frames * r)
+    starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
+    return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
+
+
+ARGS = {"mp4": mp4_args, "gif": gif_args}
+
+# What ffmpeg reports in the system's own words (av_strerror is strerror) when the file system fails it: then
+# the user reads that reason and the file, as for any other write, not ffmpeg's account of its muxer.
+FILE_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM,
+               errno.ENOENT, errno.ESTALE)
+
+
+def os_error(log: str) -> int | None:
+    """The errno of the first file-system error an ffmpeg log names, if any."""
+    found = [(log.find(os.strerror(code)), code) for code in FILE_ERRORS if os.strerror(code) in log]
+    return min(found)[1] if found else None
+
+
+class _Still:
+    """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
+
+    def __init__(self, final: Path):
+        self.final, self.tmp, self.frame = final, temp_beside(final, suffix=".part"), None
+
+    def finish(self):
+        import imageio.v3 as iio
+        try:
+            iio.imwrite(self.tmp, self.frame, extension=".png")
+        except OSError as e:  # name the file the user asked for, not the hidden temporary
+            raise OSError(e.errno, e.strerror, str(self.final)) from e
+
+
+class _Target:
+    """One ffmpeg process, the thread that feeds it, and where its output goes."""
+
+    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None):
+        self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
+        self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
+        self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
+        self.error: BaseException | None = None
+        self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
+        try:
+            fcntl.fcntl(proc.stdin.fileno(), F_SETPIPE_SZ, PIPE_BYTES)
+        except (OSError, AttributeError):
+            pass  # a smaller pipe only means more system calls
+        self.thread = threading.Thread(target=self._pump, name=f"encode-{final.suffix[1:]}", daemon=True)
+        self.thread.start()
+
+    def _pump(self):
+        fd = self.proc.stdin.fileno()
+        while True:
+            frame = self.queue.get()
+            if frame is None:
+                return
+            if self.error is not None:
+                continue  # keep draining so the producer never blocks on a dead encoder
+            t = time.perf_counter()
+            try:
+                view = memoryview(np.ascontiguousarray(frame)).cast("B")
+                while view:  # os.write releases the GIL while it blocks on the pipe
+                    view = view[os.write(fd, view):]
+            except BaseException as e:  # a dead ffmpeg: report it from the main thread
+                self.error = e
+            self.busy_s += time.perf_counter() - t
+
+
+class Encoder:
+    """Writes `frames` to out_dir/NAME.<fmt> for each format; use as a context manager or call close/abort."""
+
+    def __init__(self, out_dir: Path, name: str, video, frames: int, formats=None):
+        self.targets: list[_Target] = []
+        self.written = 0
+        self.stills: list[_Still] = []
+        exe = imageio_ffmpeg.get_ffmpeg_exe()
+        try:
+            for fmt in formats or video.formats:
+                final = out_dir / f"{name}.{fmt}"
+                if fmt == "png":
+                    self.stills.append(_Still(final))
+                    continue
+                tmp = temp_beside(final, suffix=".part")
+                log = tempfile.TemporaryFile()
+                rate = gif_rate(video) if fmt == "gif" else video.fps
+                cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+                       "-s", f"{video.width}x{video.height}", "-r", str(rate), "-i", "-", "-an",
+                       *ARGS[fmt](video), tmp]
+                try:
+                    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
+                                            start_new_session=True)  # Ctrl-C reaches us, and we clean up
+                except BaseException:
+                    tmp.unlink(missing_ok=True)
+                    log.close()
+                    raise
+                self.targets.append(_Target(final, tmp, proc, log,
+                                            gif_repeats(video, frames) if fmt == "gif" else None))
+        except BaseException:
+            self.abort()
+            raise
+
+    @property
+    def busy_s(self) -> float:
+        """Seconds the busiest writer spent feeding ffmpeg."""
+        return max((t.busy_s for t in self.targets), default=0.0)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, tb):
+        if kind is None:
+            self.close()
+        else:
+            self.abort()
+
+    def write(self, frame: np.ndarray):
+        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind.
+
+        The frame is shared, not copied: do not modify it after writing it.
+        """
+        for t in self.targets:
+            if t.error is not None:
+                try:
+                    t.proc.wait(timeout=5)  # its pipe broke as it exits: its log is then complete
+                except subprocess.TimeoutExpired:
+                    pass
+                raise self._failure("stopped", t.error)
+        for t in self.targets:
+            for _ in range(1 if t.repeats is None else t.repeats[self.written]):
+                t.queue.put(frame)
+        self.written += 1
+        for s in self.stills:
+            s.frame = frame  # shared like the queues' frames: only the last one is kept
+
+    def close(self) -> dict[str, int]:
+        """Finish encoding and rename into place; returns file name -> bytes."""
+        for t in self.targets:
+            t.queue.put(None)
+        for t in self.targets:
+            t.thread.join()
+            try:
+                t.proc.stdin.close()  # EOF: ffmpeg flushes (the GIF's palette needs every frame first)
+            except OSError:
+                pass
+        codes = [t.proc.wait() for t in self.targets]
+        errors = [t.error for t in self.targets if t.error is not None]
+        if errors or any(codes):
+            failure = self._failure("failed", errors[0] if errors else f"exit status {max(codes)}")
+            self.abort()
+            raise failure
+        try:
+            for s in self.stills:
+                s.finish()
+        except BaseException:
+            self.abort()
+            raise
+        sizes = {}
+        for t in [*self.targets, *self.stills]:
+            publish(t.tmp, t.final)
+            sizes[t.final.name] = t.final.stat().st_size
+        for t in self.targets:
+            t.log.close()
+        self.targets, self.stills = [], []
+        return sizes
+
+    def abort(self):
+        """Stop ffmpeg and remove the temporary files; safe to call more than once."""
+        for t in self.targets:
+            t.error = t.error or EncodeError("aborted")
+            t.proc.kill()  # unblocks a writer stuck on a full pipe: its write fails and it drains the queue
+        for t in self.targets:
+            t.proc.wait()
+            try:
+                t.queue.put(None, timeout=5)  # the writer drains, so there is room soon
+            except queue.Full:
+                pass
+            t.thread.join(timeout=5)
+            t.tmp.unlink(missing_ok=True)
+            t.log.close()
+        for s in self.stills:
+            s.tmp.unlink(missing_ok=True)
+        self.targets, self.stills = [], []
+
+    def _failure(self, how: str, fallback) -> Exception:
+        """What to raise when an ffmpeg process failed: the OS's reason and the file when the file system
+        failed it (OSError, e.g. "No space left on device: out/NAME/NAME.mp4"), else EncodeError with the
+        last line of each ffmpeg's log."""
+        logs = [self._log(t) for t in self.targets]
+        for t, log in zip(self.targets, logs):
+            code = os_error(log)
+            if code is not None:
+                return OSError(code, os.strerror(code), str(t.final))
+        return EncodeError(f"ffmpeg {how}: {' | '.join(x.splitlines()[-1] for x in logs if x) or fallback}")
+
+    @staticmethod
+    def _log(t: _Target) -> str:
+        t.log.seek(0)
+        return t.log.read().decode(errors="replace").strip()
+
+
+def ffmpeg_version() -> str:
+    return imageio_ffmpeg.get_ffmpeg_version()

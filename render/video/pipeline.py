@@ -1,0 +1,268 @@
+"""Scene -> simulation -> canvas -> encoders: one render, and the draw-free `simulate`."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from ..trust import certify, quality
+from ..physics import grid, registry, runtime
+from .atomic import digest, replacing, write_atomic
+from ..physics.system import DEFAULT_MAX_DRIFT
+from .version import __version__
+
+
+def make_system(scene, subset=None):
+    """The scene's system, built by the class the registry holds for it."""
+    return registry.get(scene.system)(scene, subset)
+
+
+def prepare(scene, arch: str, threads: int | None):
+    """Before the first frame: the integrator a --quality level calls for, and its faithfulness certificate,
+    which refuses (SimulationError) a run that would be untrue for most of the video. Nothing is written yet."""
+    t = time.perf_counter()
+    scene, chosen = quality.choose(scene, arch, threads)
+    t_quality = time.perf_counter() - t
+    # A map certifies the lattice its trust mask is read from (render/physics/grid.py), not 128 pixels in row order.
+    cert = certify.certify(scene, arch, threads, grid.trust_indices(scene) if scene.fractal else None)
+    timings = {"quality": t_quality, "certify": cert.cost_s} if scene.quality else {"certify": cert.cost_s}
+    if scene.has("lyapunov"):  # before the render's own runtime.init: the spectrum runs in f64
+        from ..trust import lyapunov
+        t = time.perf_counter()
+        cert = dataclasses.replace(cert, lyapunov=lyapunov.for_certificate(scene, cert, arch, threads))
+        timings["lyapunov"] = time.perf_counter() - t
+    return scene, chosen, cert, timings
+
+
+def progress_bar(total: int, desc: str, enabled: bool):
+    from tqdm import tqdm
+    return tqdm(total=total, desc=desc, unit="frame", file=sys.stderr, disable=not enabled, leave=False,
+                dynamic_ncols=True)
+
+
+def frames(scene, sim, timings: dict, advance=None):
+    """Yield each frame index with the simulation at that frame's time (frame 0 is t=0), watchdog checked.
+    `advance` moves it one frame on (default: sim.advance_frame; a map stops pixels at their events)."""
+    advance = advance or sim.advance_frame
+    max_drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
+    for f in range(scene.frames):
+        t = time.perf_counter()
+        if f:
+            advance()
+        if scene.has("energy"):
+            sim.measure_energy(first=f == 0)
+        sim.check(f, max_drift)
+        timings["simulate"] += time.perf_counter() - t
+        yield f
+
+
+@contextmanager
+def output_dir(path: Path):
+    """Create the directory; if the block fails, remove it again, and the parents it made, when empty."""
+    made = [p for p in (path, *path.parents) if not p.exists()]  # e.g. out/compare/ for a first comparison
+    path.mkdir(parents=True, exist_ok=True)
+    try:
+        yield path
+    except BaseException:
+        for p in made:  # deepest first
+            try:
+                p.rmdir()
+            except OSError:
+                break
+        raise
+
+
+class Source:
+    """The frames of a scene, one at a time, after prepare(): what `render` encodes and `show` plays.
+
+    next_frame() returns the frame at index + 1 (frame 0 is t = 0), watchdog checked; reset() rewinds to
+    t = 0 in place, so the same frames follow again (Taichi fields are never freed: none are made anew).
+    """
+
+    def __init__(self, scene, arch: str = "cpu", threads: int | None = None):
+        self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
+        self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
+        self.sim = make_system(self.scene)
+        if self.scene.fractal:
+            if self.scene.fractal == "lyapunov":
+                from ..maps.ftle import FtleMap as Map  # it carries each pixel's tangent vectors through the frame
+            else:
+                from ..maps.fractal import Map
+            self.canvas = Map(self.scene, self.sim, self.cert)  # it advances the pixels too: events per substep
+        else:
+            from ..draw.canvas import Canvas
+            from ..draw.hud import Info
+            self.canvas = Canvas(self.scene, self.sim, Info.of(self.scene, self.sim.h, self.cert))
+        self.name, self.frames = self.scene.name, self.scene.frames
+        self.timings = {**before, "simulate": 0.0, "draw": 0.0}
+        self.reset(rewind=False)
+
+    def reset(self, rewind: bool = True):
+        if rewind:
+            self.sim.restart()
+            self.canvas.restart()
+        self._steps = frames(self.scene, self.sim, self.timings,  # frame 0 measures the energy afresh
+                             getattr(self.canvas, "advance_frame", None))
+        self.index = -1
+
+    def next_frame(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The next frame as H×W×3 uint8, written into `out` if given (else a new array)."""
+        self.index = next(self._steps)
+        t = time.perf_counter()
+        frame = self.canvas.draw(out, self.index / self.scene.video.fps)
+        self.timings["draw"] += time.perf_counter() - t
+        return frame
+
+
+def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
+    """A scene simulated to the end without drawing, as `render` simulates it (prepare(), the watchdog): a
+    comparison's variant, each in its own precision before the panels are drawn (render/draw/split.py).
+
+    Returns the scene as run, `chosen`, `cert`, `timings`, `q` (frames, N, D) float64 at every frame time,
+    `cost` (wall seconds of simulation per simulated second, steady: from the second advance on, since the
+    first one compiles or loads the kernel), and what metadata reports of the run: `integrator`, `energy`,
+    `kernels`, `fields`."""
+    scene, chosen, cert, timings = prepare(scene, arch, threads)
+    runtime.init(arch, scene.integrator.precision, threads)
+    sim = make_system(scene)
+    timings["simulate"] = 0.0
+    q = np.empty((scene.frames, sim.n, sim.D))
+    warm = 0.0
+    for f in frames(scene, sim, timings):
+        q[f] = sim.q.to_numpy()
+        if f == 1:
+            warm = timings["simulate"]
+    steady = scene.frames - 2
+    cost = (timings["simulate"] - warm) * scene.video.fps / steady if steady > 0 else timings["simulate"] / \
+        scene.video.duration
+    return {"scene": scene, "chosen": chosen, "cert": cert, "timings": timings, "q": q, "cost": cost,
+            "integrator": integrator_meta(scene, sim), "energy": energy_meta(scene, sim),
+            "kernels": list(runtime.launched), "fields": dict(runtime.allocated)}
+
+
+def open_source(scene, arch: str = "cpu", threads: int | None = None):
+    """What `render` encodes and `show` plays: the scene's Source, or a comparison's split screen."""
+    if not scene.compare:
+        return Source(scene, arch, threads)
+    from ..draw.split import SplitScreen
+    return SplitScreen(scene, lambda variant: record(variant, arch, threads), arch, threads)
+
+
+def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
+           frame_hook=None) -> dict:
+    """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
+    wrote. frame_hook(f, frame) sees raw frames."""
+    from .encode import Encoder
+
+    t_start = time.perf_counter()
+    src = open_source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
+    scene, timings = src.scene, src.timings
+    timings["encode"] = 0.0
+    with output_dir(scene.out_dir(out_root)) as out_dir:
+        enc = Encoder(out_dir, scene.name, scene.video, scene.frames)
+        try:
+            with progress_bar(scene.frames, scene.name, progress) as bar:
+                for f in range(scene.frames):
+                    frame = src.next_frame()  # a new array: the encoder shares it, it does not copy
+                    if frame_hook:
+                        frame_hook(f, frame)
+                    t = time.perf_counter()
+                    enc.write(frame)  # blocks only when the encoder is behind
+                    timings["encode"] += time.perf_counter() - t
+                    bar.update()
+            t = time.perf_counter()
+            sizes = enc.close()
+            timings["encode"] += time.perf_counter() - t
+        except BaseException:
+            enc.abort()
+            raise
+        timings["total"] = time.perf_counter() - t_start
+        sha256 = {f: digest(out_dir / f) for f in sizes}
+        if scene.compare:
+            meta = src.metadata(header(scene, src.arch), timings, sizes, sha256)
+        else:
+            meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen, sha256)
+        if scene.fractal:
+            meta["map"] = src.canvas.summary()
+        if scene.has("poincare"):
+            meta["poincare"] = src.canvas.section.summary()
+        write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
+    return meta
+
+
+def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = False) -> dict:
+    """The state at every frame time (DESIGN.md: t, theta/omega or pos/vel, energy), as float64 arrays in
+    the returned info's "arrays", and written to out_file (a .npz) unless that is None."""
+    if not scene.has("energy"):
+        scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
+    scene, chosen, cert, before = prepare(scene, arch, None)
+    runtime.init(arch, scene.integrator.precision)
+    sim = make_system(scene)
+    timings = {**before, "simulate": 0.0}
+    rows: dict[str, list] = {"t": [], "energy": []}
+    with progress_bar(scene.frames, scene.name, progress) as bar:
+        for f in frames(scene, sim, timings):
+            rows["t"].append(f / scene.video.fps)
+            rows["energy"].append(sim.e.to_numpy())
+            for k, v in sim.state().items():
+                rows.setdefault(k, []).append(v)
+            bar.update()
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in rows.items()}
+    if out_file is not None:
+        out_file = Path(out_file)
+        with output_dir(out_file.parent), replacing(out_file, suffix=".npz") as tmp:  # savez wants the .npz
+            np.savez_compressed(tmp, **arrays)
+    return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
+            "integrator": integrator_meta(scene, sim), "faithfulness": cert.to_dict(), "quality": chosen,
+            "line": cert.line(), "arrays": arrays}
+
+
+def integrator_meta(scene, sim) -> dict:
+    return {"method": scene.integrator.method, "dt": sim.h, "dt_requested": scene.integrator.dt,
+            "substeps": sim.substeps, "precision": scene.integrator.precision}
+
+
+def header(scene, arch: str) -> dict:
+    """What every metadata.json opens with: the scene, the versions, the video."""
+    import taichi as ti
+    from .encode import ffmpeg_version
+
+    v = scene.video
+    return {
+        "preset": scene.to_dict(),
+        "preset_hash": scene.hash(),
+        "source": scene.source,
+        "versions": {"package": __version__, "taichi": ".".join(map(str, ti.__version__)),
+                     "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
+        "arch": arch,
+        "frames": scene.frames, "fps": v.fps, "width": v.width, "height": v.height, "duration": v.duration,
+    }
+
+
+def energy_meta(scene, sim) -> dict | None:
+    if not scene.has("energy"):
+        return None
+    return {"initial_total": float(sim.e0.to_numpy().sum()), "max_rel_drift": float(sim.drift[None])}
+
+
+def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict,
+             sha256: dict | None = None) -> dict:
+    return {
+        **header(scene, arch),
+        "integrator": integrator_meta(scene, sim),
+        "effects": list(scene.effects),
+        "kernels": list(runtime.launched),
+        "field_bytes": sum(runtime.allocated.values()),
+        "fields": dict(runtime.allocated),
+        "energy": energy_meta(scene, sim),
+        "faithfulness": cert.to_dict(),
+        "quality": chosen,
+        "timings_s": {k: round(val, 4) for k, val in timings.items()},
+        "outputs": sizes,
+        "outputs_sha256": sha256 or {},  # file name -> sha256: `batch` re-renders a file changed in place
+    }
