@@ -98,6 +98,7 @@ def band(height: int) -> int:
 
 
 def pad(height: int) -> int:
+    """The margin above and below the shared clock."""
     return max(2, round(0.008 * height))
 
 
