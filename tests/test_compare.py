@@ -13,8 +13,10 @@ import pytest
 
 from conftest import ROOT
 from render.commands import batch, cli
+from render.draw import hud, split
 from render.video import pipeline
-from render.draw import split
+from render.draw.font import Font, text_height, text_width
+from render.config.options import output_name
 from render.config.scene import load
 
 # rigid_chaos as shipped, but small and short enough for a test: the fan still parts under f32 by 9 s.
@@ -37,9 +39,9 @@ def main(*argv) -> tuple[int, str, str]:
     return code, out.getvalue(), err.getvalue()
 
 
-def panels(frame, meta, band):
-    """Each panel of a decoded frame below its label band, as int arrays."""
-    return [frame[p["y"] + band:p["y"] + p["height"], p["x"]:p["x"] + p["width"]].astype(int)
+def panels(frame, meta, band, hud=0):
+    """Each panel of a decoded frame below its label band (and above its bottom `hud` rows), as int arrays."""
+    return [frame[p["y"] + band:p["y"] + p["height"] - hud, p["x"]:p["x"] + p["width"]].astype(int)
             for p in meta["compare"]["panels"]]
 
 
@@ -66,8 +68,9 @@ def test_the_two_panels_start_equal_and_part(precision):
     video = iio.imread(folder / "rigid_chaos.mp4")
     assert video.shape == (135, 180, 320, 3)
     band = 2 + 4 * 13  # four label lines of the 6x13 font
-    early = [np.abs(np.subtract(*panels(video[f], meta, band))).mean() for f in (0, 8, 15)]
-    late = np.abs(np.subtract(*panels(video[-1], meta, band))).mean()
+    hud = 42  # the spread graph and the clock, which each panel draws by its own certificate's times
+    early = [np.abs(np.subtract(*panels(video[f], meta, band, hud))).mean() for f in (0, 8, 15)]
+    late = np.abs(np.subtract(*panels(video[-1], meta, band, hud))).mean()
     assert max(early) < 3, early  # the same picture, up to H.264 noise
     assert late > 10, late  # the f32 fan has scattered differently
     gif = iio.imread(folder / "rigid_chaos.gif")
@@ -93,11 +96,14 @@ def test_labels_show_the_variant_the_cost_and_the_live_error(precision):
         assert v["faithfulness"]["shadow"]["precision"] == "f64" and v["timings_s"]["simulate"] > 0
     assert v32["faithfulness"]["median_until_s"] < v64["faithfulness"]["median_until_s"]
     assert meta["integrator"] == v64["integrator"] and meta["faithfulness"] == v64["faithfulness"]
+    assert v32["max_error"] <= np.pi and "wrapped to [0, π]" in meta["compare"]["error"]  # the fan has scattered
 
 
 @pytest.fixture(scope="module")
 def methods_source():
-    scene = load("compare_methods", ["video.width=256", "video.height=144", "video.fps=10", "video.duration=2"])
+    # overridden as `pendulum compare compare_methods --set ...` is: the scene is named for its folder
+    scene = output_name(load("compare_methods", ["video.width=256", "video.height=144", "video.fps=10",
+                                                  "video.duration=2"]), True)
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(split, "cost", lambda run: 0.125)  # measured times differ run to run: fixed for bytes
         yield lambda threads: pipeline.open_source(scene, threads=threads)
@@ -112,17 +118,108 @@ def digest(src) -> str:
 
 def test_the_split_screen_is_a_frame_source_deterministic_at_any_thread_count(methods_source):
     one = methods_source(1)
-    assert (one.name, one.frames, one.index) == ("compare_methods", 20, -1)
+    assert re.fullmatch(r"compare_methods__[0-9a-f]{8}", one.name) and (one.frames, one.index) == (20, -1)
     first = digest(one)
     assert one.index == 19
     one.reset()
     assert one.index == -1 and digest(one) == first  # reset() replays the same frames
     assert digest(methods_source(2)) == first
     lines = [text for text, _ in one.label_lines(0, 19)]
-    assert lines[0] == "method = symplectic_euler, dt = 0.00025" and lines[2] == "cost 125 ms per simulated s"
+    # the step once, as run: the variant names it, so the integrator's line says only the precision
+    assert lines[:3] == ["method = symplectic_euler, dt = 2.5e-4 s", "f64", "cost 125 ms per simulated s"]
+    assert one.runs[0]["integrator"]["dt"] == 2.5e-4  # as run: whole steps fit a frame at 10 fps
     assert re.fullmatch(r"Δθ \S+ rad(, parted at \d+\.\d\d s)?", lines[3]), lines
+    assert re.fullmatch(r"faithful to (the end|\d+\.\d\d s)", lines[4]), lines
     assert one.runs[one.ref]["integrator"]["method"] == "rk4"  # equal cost: rk4 is the finest
-    assert any(text.startswith("parted: Δθ > 0.001") for text, *_ in one.labels(0))  # the legend, 4th cell
+    items = [text for text, *_ in one.labels(0)]
+    assert any(text.startswith("parted: Δθ > 0.001") for text in items)  # the legend, 4th cell
+    legend = split.layout(256, 144, 4)[3]
+    titles = [text for text, x, y, _ in one.labels(0) if (x, y) == (legend[0] + 4, legend[1] + 2)]
+    assert titles == ["compare_methods"]  # the legend's title: the preset, not the folder NAME__<hash>
+
+
+@pytest.mark.parametrize("x, text", [(0.0, "Δθ 0 rad"), (1e-4, "Δθ 1.0e-04 rad"), (-0.42, "Δθ 0.42 rad"),
+                                     (144.0, "Δθ 0.51 rad"), (2 * np.pi + 1e-3, "Δθ 1.0e-03 rad"),
+                                     (np.pi, "Δθ 3.1 rad"), (-np.pi, "Δθ 3.1 rad")])
+def test_an_angle_error_is_wrapped(x, text):
+    assert split.error_text("Δθ", x, True) == text  # 144 rad is 23 turns less 0.513 rad
+
+
+def test_an_angle_error_never_reads_above_pi():
+    xs = np.concatenate([np.linspace(-150, 150, 30001), [144.0, np.pi, -np.pi, 3 * np.pi, np.nextafter(np.pi, 4)]])
+    read = [float(split.error_text("Δθ", x, True).split()[1]) for x in xs]
+    assert max(read) <= np.pi and max(read) == 3.1
+    wrapped = split.turned(xs)
+    assert np.all((wrapped > -np.pi) & (wrapped <= np.pi))  # (−π, π]
+    assert np.allclose(np.cos(wrapped), np.cos(xs)) and np.allclose(np.sin(wrapped), np.sin(xs))  # the same angle
+    assert split.error_text("Δx/L", 44.0, False) == "Δx/L 44"  # a spring's stretch is not an angle
+
+
+def test_the_legend_is_titled_by_the_preset_not_its_folder():
+    for sets, name in (([], None), (["video.fps=30"], None), (["video.fps=30"], "mine")):
+        scene = output_name(load("compare_methods", sets), bool(sets), name)
+        assert split.preset_name(scene) == "compare_methods", scene.name
+    assert split.preset_name(scene.variants()[1]) == "compare_methods"  # a variant's source names the preset
+
+
+@pytest.fixture(scope="module")
+def precision_frames():
+    """compare_precision, small, as rendered: its split screen's raw frames. At 10 fps over 10 s the f64
+    panel's own certificate ends before the video does (the f32 one's after a few seconds)."""
+    scene = load("compare_precision", ["video.width=256", "video.height=144", "video.fps=10", "video.duration=10"])
+    src = pipeline.open_source(scene)
+    return src, [src.next_frame() for _ in range(src.frames)]
+
+
+def clock_colours(src, frames, i) -> list[str]:
+    """Panel i's HUD clock's colour at each frame: of white, amber and red, the one most of the pixels in the
+    clock's box have exactly (the HUD draws it under max: a glyph pixel is the colour, unless a rod is there)."""
+    x0, y0, _, _ = src.rects[i]
+    h = src.panels[i].canvas.hud
+    width, height = text_width("t = 99.99 s", h.bs, h.big), text_height("t", h.bs, h.big)
+    right, bottom = x0 + h.w - h.m, y0 + h.h - h.m
+    names = {"white": hud.WHITE, "amber": hud.AMBER, "red": hud.RED}
+    out = []
+    for frame in frames:
+        box = frame[bottom - height:bottom, right - width:right].astype(int)
+        counts = {k: int(np.all(box == np.floor(np.array(c) * 255 + 0.5), axis=-1).sum()) for k, c in names.items()}
+        assert max(counts.values()) > 20, counts  # the clock is there
+        out.append(max(counts, key=counts.get))
+    return out
+
+
+def test_each_panels_clock_turns_at_its_own_certificates_times(precision_frames):
+    src, frames = precision_frames
+    fps, duration = src.scene.video.fps, src.scene.video.duration
+    assert [r["integrator"]["precision"] for r in src.runs] == ["f32", "f64"] and src.ref == 1
+    for i, run in enumerate(src.runs):
+        cert = run["cert"]
+        assert cert.faithful_until_s < duration  # the finest too: its own certificate ends before the video
+        seen = clock_colours(src, frames, i)
+        first = round(cert.faithful_until_s * fps) + 1  # the first frame after its last faithful one
+        assert seen[:first] == ["white"] * first, (i, seen)
+        assert seen[first] != "white", (i, seen)
+        want = ["red" if f / fps > cert.median_until_s + 1e-9 else "amber" for f in range(first, len(frames))]
+        assert seen[first:] == want, (i, seen)
+        label = src.label_lines(i, 0)[-1][0]
+        assert label == f"faithful to {cert.faithful_until_s:.2f} s", label  # said from the first frame on
+    f32, f64 = (run["cert"] for run in src.runs)
+    assert f32.faithful_until_s < f64.faithful_until_s  # each its own: the f64 one from its own shadow run
+
+
+def test_one_shared_clock_is_drawn_big_across_the_top(precision_frames):
+    src, frames = precision_frames
+    top = split.band(144) - split.GAP
+    size, scale = split.clock_face(144)
+    assert text_height("t", scale, size) >= 13 and split.clock_face(720) == ("10x20", 2)  # 40 px tall at 720p
+    font = Font()
+    for f in (0, 37, 99):
+        alone = np.zeros((top, 256, 3), np.uint8)
+        font.draw(alone, f"t = {f / 10:5.2f} s", 128, split.pad(144), colour=split.COLOURS["clock"], size=size,
+                  scale=scale, ha="center")
+        assert np.array_equal(frames[f][:top], alone), f  # the band holds the clock and nothing else
+        assert (frames[f][top:top + split.GAP] == split.DIVIDER).all()  # then the grey line over the panels
+    assert all(y >= split.band(144) for _, y, _, _ in src.rects)
 
 
 BAD = [

@@ -30,11 +30,13 @@ EXAMPLES = """examples:
   pendulum compare elastic_fan --vary pendulums.stiffness=2e3,2e4 --set video.duration=8
   pendulum compare compare_methods            # a preset's own [compare] table
 
-Each panel is labelled with its variant, its integrator, its cost (wall time of its simulation per simulated
-second, measured) and its error: the largest difference of any of its pendulums from the same pendulum of
-the finest variant (Δθ in rad; springs: Δx as a fraction of the total length), live, and when it parts
-from it by more than integrator.tolerance. metadata.json records every variant's integrator, timings,
-certificate and divergence time."""
+One shared clock across the top. Each panel is labelled with its variant, its integrator as run, its
+cost (wall time of its simulation per simulated second, measured), its error: the largest difference of any
+of its pendulums from the same pendulum of the finest variant (Δθ in rad, wrapped to at most π; springs: Δx
+as a fraction of the total length), live, and when it parts from it by more than integrator.tolerance; and
+until when its own certificate holds it faithful, the finest too: its clock turns amber then, and red once
+half its pendulums are not. metadata.json records every variant's integrator, timings, certificate and
+divergence time."""
 
 
 def add_parser(sub):

@@ -1,5 +1,6 @@
-"""A comparison's frames: its variants side by side (2) or 2x2 (3 or 4), each panel drawn by the render's own
-canvas at the panel's size, labelled with the variant, its measured cost and its error against the finest.
+"""A comparison's frames: its variants side by side (2) or 2x2 (3 or 4) under one shared clock, each panel
+drawn by the render's own canvas at the panel's size, labelled with the variant, its measured cost, its error
+against the finest and until when its own certificate holds it faithful.
 
 Two passes, because Taichi holds one precision per process (render/physics/runtime.py) and variants may differ in it:
 
@@ -9,11 +10,15 @@ Two passes, because Taichi holds one precision per process (render/physics/runti
    source like pipeline.Source), and every label in one kernel launch of the bundled font.
 
 The finest variant is the one its certificate trusts longest (median, then first pendulum's faithful time);
-ties go to f64, the higher order, the smaller step, then the order given. A panel's error at a frame is the
+ties go to f64, the higher order, the smaller step, then the order given. It is only the best of those shown,
+not the truth: every panel, the finest too, says until when its own certificate (its own shadow run) holds it
+faithful, and its HUD clock turns amber and red at that certificate's times. A panel's error at a frame is the
 largest deviation of any of its pendulums from the same pendulum of the finest variant (System.deviation:
-rad on any angle; springs, a fraction of the total rest length), shown live; it parts from the finest at the
-first frame where that error exceeds its integrator.tolerance. The cost is the wall time its simulation took
-per simulated second in pass 1, when nothing else of the render runs.
+rad on any angle, the difference wrapped to (−π, π] first, since angles a turn apart draw the same picture;
+springs, a fraction of the total rest length), shown live; it parts from the finest at the first frame where
+that error exceeds its integrator.tolerance. The cost is the wall time its simulation took per simulated
+second in pass 1, when nothing else of the render runs. The step is said once, as run (System.h, which fits
+whole steps into a frame, not the dt asked for).
 
 Frames are deterministic at any thread count (recorded states, the canvas's order-free compositing, serial
 text) except the cost figures, which are measured; tests that compare bytes replace `cost`.
@@ -22,17 +27,22 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 
 from ..physics import integrators, registry, runtime
+from .font import text_height
+from .hud import faces, step
 
 GAP = 2  # px of grey at least between panels
 DIVIDER = 72  # its grey level
 LARGE = 300  # panels at least this tall get the 10x20 font, smaller ones 6x13
 LABEL_SHARE = 0.4  # of a panel's height its label may cover (from the top)
 COLOURS = {"title": (1.0, 1.0, 1.0), "detail": (0.7, 0.7, 0.7), "close": (0.45, 0.95, 0.5),
-           "parted": (1.0, 0.55, 0.2), "finest": (0.55, 0.75, 1.0)}
+           "parted": (1.0, 0.55, 0.2), "finest": (0.55, 0.75, 1.0), "clock": (1.0, 1.0, 1.0)}
+DROP = (1, 2, 4)  # a short panel's label leaves out the integrator's line, then the cost, then its faithful time
+INTEGRATOR = ("integrator.method", "integrator.dt", "integrator.precision")  # said as run, once
 
 
 def cost(run: dict) -> float:
@@ -41,10 +51,11 @@ def cost(run: dict) -> float:
 
 
 def shown(lines: list, room: int) -> list:
-    """The label's lines that fit in `room` lines, in their order: the integrator's line goes first, then
-    the cost; the variant and its error always stay."""
-    drop = [1, 2][:max(0, len(lines) - room)]
-    return [line for k, line in enumerate(lines) if k not in drop]
+    """The label's lines (label_lines) that fit in `room` lines, in their order, empty ones left out: the
+    integrator's line goes first, then the cost, then the faithful time; the variant and its error stay."""
+    kept = [k for k, (text, _) in enumerate(lines) if text]
+    drop = [k for k in DROP if k in kept][:max(0, len(kept) - room)]
+    return [lines[k] for k in kept if k not in drop]
 
 
 def fit(text: str, width: int, cell: int) -> str:
@@ -58,13 +69,52 @@ def amount(x: float) -> str:
     return "0" if x == 0 else f"{x:.1e}" if x < 0.1 else f"{x:.2g}" if x < 10 else f"{x:.0f}"
 
 
+def turned(x):
+    """Angles (rad) wrapped to (−π, π]: a difference of whole turns is no difference on screen."""
+    r = np.pi - np.mod(np.pi - np.asarray(x, dtype=np.float64), 2 * np.pi)
+    return np.where(r <= -np.pi, r + 2 * np.pi, r)  # mod rounds a hair above π to 2π: back to π
+
+
+def error_text(delta: str, x: float, angles: bool) -> str:
+    """A panel's live error: `delta` (Δθ or Δx/L) and its size; an angle's wrapped, so it never reads above π."""
+    return f"{delta} {amount(abs(float(turned(x))))} rad" if angles else f"{delta} {amount(x)}"
+
+
+def faithful_text(cert, duration: float) -> str:
+    """Until when a panel's own certificate holds all its certified pendulums faithful."""
+    until = cert.faithful_until_s
+    return "faithful to the end" if until >= duration else f"faithful to {until:.2f} s"
+
+
+def clock_face(height: int) -> tuple[str, int]:
+    """The shared clock's font (size, scale): the HUD's big face for a frame `height` pixels high."""
+    return faces(height)[1]
+
+
+def band(height: int) -> int:
+    """The height of the shared clock's band across the top, the grey line under it included (even)."""
+    size, scale = clock_face(height)
+    return (text_height("t", scale, size) + 2 * pad(height) + GAP + 1) // 2 * 2
+
+
+def pad(height: int) -> int:
+    """The margin above and below the shared clock."""
+    return max(2, round(0.008 * height))
+
+
 def layout(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
-    """(x, y, w, h) of each of n panels: side by side for 2, row by row in 2x2 for 3 or 4. Sizes are even (a
-    panel is a valid video size) and leave at least GAP between panels."""
-    rows = 1 if n == 2 else 2
-    pw, ph = (width - GAP) // 2 // 2 * 2, (height - GAP * (rows - 1)) // rows // 2 * 2
-    ys = (0,) if rows == 1 else (0, height - ph)
+    """(x, y, w, h) of each of n panels under the clock's band: side by side for 2, row by row in 2x2 for 3
+    or 4. Sizes are even (a panel is a valid video size) and leave at least GAP between panels."""
+    rows, top = 1 if n == 2 else 2, band(height)
+    pw, ph = (width - GAP) // 2 // 2 * 2, (height - top - GAP * (rows - 1)) // rows // 2 * 2
+    ys = (top,) if rows == 1 else (top, height - ph)
     return [((0, width - pw)[i % 2], ys[i // 2], pw, ph) for i in range(n)]
+
+
+def preset_name(scene) -> str:
+    """The name of the preset a comparison came from: its file's, not the folder's (NAME__<hash>, --name)."""
+    path = scene.source.split(" (compare variant", 1)[0]
+    return Path(path).stem if path.endswith(".toml") else scene.name
 
 
 def finest(runs: list[dict]) -> int:
@@ -86,14 +136,15 @@ class Replay:
     """One variant's recorded states drawn at its panel's size by the canvas `render` draws with: a frame
     source with pipeline.Source's interface (name, frames, index, reset(), next_frame(out=None))."""
 
-    def __init__(self, scene, q: np.ndarray):
+    def __init__(self, scene, q: np.ndarray, cert):
         from .canvas import Canvas
         from .hud import Info
 
         self.scene, self.q = scene, q
         self.name, self.frames = scene.name, len(q)
         self.sim = registry.get(scene.system)(scene)
-        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, panel=True))  # the HUD, if called for
+        # the HUD, if called for, with the variant's own certificate: its clock's colours and timeline ticks
+        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True))
         self.reset(rewind=False)
 
     def reset(self, rewind: bool = True):
@@ -123,14 +174,15 @@ class SplitScreen:
         v = scene.video
         self.rects = layout(v.width, v.height, len(self.runs))
         self.arch = runtime.init(arch, "f64", threads)  # pass 2: f64 positions, drawn in f32 pixels as ever
-        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"])
+        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"])
                        for run, (_, _, w, h) in zip(self.runs, self.rects)]
         self.buffers = [p.canvas.new_frame() for p in self.panels]
-        ref_q = self.runs[self.ref]["q"]
-        self.errors = [self.panels[self.ref].sim.deviation(run["q"], ref_q).max(-1) for run in self.runs]
+        self.angles = registry.get(scene.system).ANGLES
+        ref_q, sim = self.runs[self.ref]["q"], self.panels[self.ref].sim
+        self.errors = [sim.deviation(turned(run["q"] - ref_q), 0.0).max(-1) if self.angles else
+                       sim.deviation(run["q"], ref_q).max(-1) for run in self.runs]
         self.parted = [self.divergence(i) for i in range(len(self.runs))]
         self.costs = [cost(run) for run in self.runs]
-        self.angles = registry.get(scene.system).ANGLES
         self.delta = "Δθ" if self.angles else "Δx/L"  # what the error measures: rad, or of the total length
         self.font = Font()
         self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
@@ -155,50 +207,71 @@ class SplitScreen:
         v = self.scene.video
         frame = np.empty((v.height, v.width, 3), np.uint8) if out is None else out
         frame.fill(DIVIDER)  # what the panels leave uncovered is the grey between them
+        frame[:band(v.height) - GAP] = 0  # the shared clock's band
         if len(self.rects) == 3:
             x, y, w, h = layout(v.width, v.height, 4)[3]
             frame[y:y + h, x:x + w] = 0  # the free cell holds the legend
         for panel, buf, (x, y, w, h) in zip(self.panels, self.buffers, self.rects):
             frame[y:y + h, x:x + w] = panel.next_frame(buf)
         self.index += 1
-        self.font.draw_many(frame, self.labels(self.index), blend="over")
+        self.font.draw_many(frame, self.labels(self.index) + [self.clock(self.index)], blend="over")
         self.timings["draw"] += time.perf_counter() - t
         return frame
 
     # ------------------------------------------------------------ labels
-    def label_lines(self, i: int, f: int) -> list[tuple[str, str]]:
-        """(text, colour name) of panel i's label at frame f."""
-        integ = self.runs[i]["integrator"]
-        variant = ", ".join(f"{key.rsplit('.', 1)[-1]} = {value_text(vals[i])}" for key, vals in self.scene.compare)
-        lines = [(variant, "title"),
-                 (f"{integ['method']}, dt {1e3 * integ['dt']:.3g} ms, {integ['precision']}", "detail"),
-                 (f"cost {1e3 * self.costs[i]:.3g} ms per simulated s", "detail")]
-        if i == self.ref:
-            return lines + [(f"finest: the reference for {self.delta}", "finest")]
-        err = f"{self.delta} {amount(self.errors[i][f])}{' rad' if self.angles else ''}"
+    def label_lines(self, i: int, f: int) -> list[tuple[str, tuple]]:
+        """(text, colour) of panel i's label at frame f: the variant, the integrator's settings the variant
+        does not name (as run), the cost, the error (or that it is the finest), and until when it is faithful.
+        An empty text is a line left out."""
+        run, t = self.runs[i], f / self.scene.video.fps
+        integ = run["integrator"]
+        said = {"integrator.method": integ["method"], "integrator.dt": f"{step(integ['dt'])} s",
+                "integrator.precision": integ["precision"]}
+        variant = ", ".join(f"{key.rsplit('.', 1)[-1]} = {said[key] if key in said else value_text(vals[i])}"
+                            for key, vals in self.scene.compare)
+        rest = [f"dt = {said[key]}" if key == "integrator.dt" else said[key]
+                for key in INTEGRATOR if key not in dict(self.scene.compare)]
+        hud = self.panels[i].canvas.hud
+        lines = [(variant, COLOURS["title"]), (", ".join(rest), COLOURS["detail"]),
+                 (f"cost {1e3 * self.costs[i]:.3g} ms per simulated s", COLOURS["detail"])]
         parted = self.parted[i]
-        if parted is not None and f / self.scene.video.fps >= parted:
-            return lines + [(f"{err}, parted at {parted:.2f} s", "parted")]
-        return lines + [(err, "close")]
+        if i == self.ref:
+            lines.append((f"finest: the reference for {self.delta}", COLOURS["finest"]))
+        else:
+            err = error_text(self.delta, self.errors[i][f], self.angles)
+            lines.append((f"{err}, parted at {parted:.2f} s", COLOURS["parted"]) if parted is not None and
+                         t >= parted else (err, COLOURS["close"]))
+        # as its clock: white while faithful, amber and red at its certificate's times (no HUD: grey)
+        return lines + [(faithful_text(run["cert"], self.scene.video.duration),
+                         COLOURS["detail"] if hud is None else hud.clock_colour(t))]
 
     def labels(self, f: int) -> list[tuple]:
         """Every panel's label (and, with 3 variants, the legend in the free cell) as Font.draw_many items."""
         big = self.size == "10x20"
-        pad, step, cell = (8, 21, 10) if big else (4, 13, 6)
-        room = max(2, int(LABEL_SHARE * self.rects[0][3]) // step)  # a small panel keeps its pendulums in view
+        pad_, step_, cell = (8, 21, 10) if big else (4, 13, 6)
+        room = max(2, int(LABEL_SHARE * self.rects[0][3]) // step_)  # a small panel keeps its pendulums in view
         cells = [(rect, shown(self.label_lines(i, f), room)) for i, rect in enumerate(self.rects)]
         if len(self.rects) == 3:
             cells.append((layout(self.scene.video.width, self.scene.video.height, 4)[3],
-                          [(text, "detail") for text in self.legend()]))
-        return [(fit(text, w - 2 * pad, cell), x + pad, y + pad // 2 + k * step,
-                 {"colour": COLOURS[colour], "size": self.size})
+                          [(text, COLOURS["detail"]) for text in self.legend()]))
+        return [(fit(text, w - 2 * pad_, cell), x + pad_, y + pad_ // 2 + k * step_,
+                 {"colour": colour, "size": self.size})
                 for (x, y, w, _), lines in cells for k, (text, colour) in enumerate(lines)]
+
+    def clock(self, f: int) -> tuple:
+        """The shared clock at frame f, big in the top centre band, as a Font.draw_many item. White: each
+        panel's own clock (its HUD) says whether that panel is still faithful."""
+        v = self.scene.video
+        size, scale = clock_face(v.height)
+        return (f"t = {f / v.fps:5.2f} s", v.width // 2, pad(v.height),
+                {"colour": COLOURS["clock"], "size": size, "scale": scale, "ha": "center"})
 
     def legend(self) -> list[str]:
         tol, unit = self.scene.integrator.tolerance, " rad" if self.angles else ""
-        return [self.scene.name, f"{self.scene.pendulums.count} pendulums, one start for all",
+        return [preset_name(self.scene), f"{self.scene.pendulums.count} pendulums, one start for all",
                 "cost: simulation wall time", f"{self.delta}: the largest of any pendulum",
-                "  from the finest variant's", f"parted: {self.delta} > {tol:g}{unit}"]
+                "  from the finest variant's", f"parted: {self.delta} > {tol:g}{unit}",
+                "clock amber: one not faithful", "clock red: half not faithful"]
 
     # ------------------------------------------------------------ metadata
     def metadata(self, header: dict, timings: dict, sizes: dict, sha256: dict) -> dict:
@@ -226,7 +299,7 @@ class SplitScreen:
                 "finest": self.ref,
                 "finest_why": "the longest median faithful time of its certificate (then the first pendulum's; "
                               "ties: f64, higher order, smaller step, the order given)",
-                "error": ("largest |Δθ| over the pendulums and angles, rad" if self.angles else
+                "error": ("largest |Δθ| over the pendulums and angles, wrapped to [0, π], rad" if self.angles else
                           "largest distance of a bob over the pendulums, as a fraction of the total rest length")
                          + ", against the same pendulum of the finest variant at each frame",
                 "variants": [self.variant_meta(i) for i in range(len(self.runs))],
