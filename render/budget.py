@@ -29,7 +29,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from .encode import QUEUE_FRAMES
+from .encode import AUDIO_KBPS, QUEUE_FRAMES
 from .errors import SceneError
 from .integrators import AUTO_DT, check_substeps
 from .keys import BUDGET_MAX
@@ -209,6 +209,8 @@ def output(scene, system, simulate: bool) -> tuple[int, str, str]:
         sizes["mp4"] = int(scene.frames * v.width * v.height * MP4_BYTES_PER_PIXEL)
     if "gif" in v.formats:
         sizes["gif"] = int(gif_frames(scene) * gif_pixels(scene) * GIF_BYTES_PER_PIXEL)
+    if scene.has("audio") and "mp4" in v.formats:  # the MP4's AAC track: its bit rate, with room to spare
+        sizes["audio"] = int(2 * v.duration * AUDIO_KBPS * 125)
     return sum(sizes.values()), "video.duration", ", ".join(f"{k} {size(b)}" for k, b in sizes.items())
 
 
