@@ -29,6 +29,15 @@ def heard(scene) -> bool:
     return scene.has("audio") and "mp4" in scene.video.formats and not scene.compare
 
 
+def peak_bytes(scene) -> int:
+    """What making the track holds at most (render/budget.py counts it): the heard angles of every frame, kept
+    and turned into pitches and phases (about 6 float64 copies), the work arrays of a chunk, and 16 bytes a
+    stereo sample (float32 samples, a channel's squares, then int16). tracemalloc: 32 MB for rigid_chaos."""
+    voices = min(VOICES, scene.pendulums.count)
+    samples = scene.frames * -(-AUDIO_RATE // scene.video.fps)
+    return scene.frames * voices * 2 * 8 * 6 + 2 * voices * 2 * CHUNK * 4 + 16 * samples
+
+
 class Voices:
     """The heard pendulums' first two angles, recorded frame by frame as a render steps; then the track."""
 
@@ -78,37 +87,39 @@ def synthesise(angles: np.ndarray, fps: int, rate: int = AUDIO_RATE) -> tuple[in
     start[1:] = np.cumsum((hz + glide / 2)[:-1] * turn, axis=0) % (2 * np.pi)
     w = np.arange(per, dtype=np.float32) / np.float32(per)  # a sample's place within its frame
     lin, quad = (hz * turn).astype(np.float32), (glide * turn / 2).astype(np.float32)
-    out = np.empty((frames, 2, per), np.float32)
+    x = np.empty((frames * per, 2), np.float32)  # level() sets the scale, not the number of voices
     chunk = max(1, CHUNK // per)  # frames
     for a in range(0, frames, chunk):
         b = slice(a, a + chunk)
         ph = lin[b, ..., None] * w
         ph += quad[b, ..., None] * (w * w)
         ph += start[b, ..., None].astype(np.float32)
-        out[b] = np.sin(ph, out=ph).sum(axis=1)
-    x = out.transpose(0, 2, 1).reshape(-1, 2).astype(np.float64) / voices
+        x.reshape(frames, per, 2)[b] = np.sin(ph, out=ph).sum(axis=1).transpose(0, 2, 1)
     return per * fps, quantise(fade(level(x, per * fps), per * fps))
 
 
 def level(x: np.ndarray, rate: int) -> np.ndarray:
-    """Even out each channel's loudness. V voices in phase are √V times louder than V voices apart (18 dB
-    for 64), so without this the fan would fall quiet as it parts and what is heard would be loudness, not
-    the tone breaking up. Each channel is divided by its RMS over LEVEL_S blocks, the gain gliding linearly
-    from block centre to block centre."""
+    """Even out each channel's loudness, in place. V voices in phase are √V times louder than V voices apart
+    (18 dB for 64), so without this the fan would fall quiet as it parts and what is heard would be loudness,
+    not the tone breaking up. Each channel is divided by its RMS over LEVEL_S blocks, the gain gliding
+    linearly from block centre to block centre."""
     n = len(x)
     starts = np.arange(0, n, max(1, round(rate * LEVEL_S)))
     sizes = np.diff(np.append(starts, n))
-    rms = np.sqrt(np.add.reduceat(x * x, starts, axis=0) / sizes[:, None])
-    gain = 1 / np.maximum(rms, 1e-3 * rms.max())  # a block of near silence is not blown up into noise
     centres = starts + sizes / 2
-    t = np.arange(n)
-    return x * np.stack([np.interp(t, centres, gain[:, c]) for c in range(x.shape[1])], axis=1)
+    for c in range(x.shape[1]):
+        col = x[:, c]
+        rms = np.sqrt(np.add.reduceat(col * col, starts, dtype=np.float64) / sizes)
+        gain = 1 / np.maximum(rms, 1e-3 * rms.max())  # a block of near silence is not blown up into noise
+        for a in range(0, n, CHUNK):  # in pieces: an hour's track is 173M samples
+            col[a:a + CHUNK] *= np.interp(np.arange(a, min(a + CHUNK, n)), centres, gain)
+    return x
 
 
 def fade(x: np.ndarray, rate: int) -> np.ndarray:
-    """Raised-cosine fades in and out, each at most half the track (a one-frame video is all fade)."""
+    """Raised-cosine fades in and out, in place, each at most half the track (a one-frame video is all fade)."""
     n = min(round(rate * FADE_S), len(x) // 2)
-    ramp = np.sin(0.5 * np.pi * (np.arange(n) + 0.5) / n)[:, None] ** 2
+    ramp = (np.sin(0.5 * np.pi * (np.arange(n) + 0.5) / n)[:, None] ** 2).astype(x.dtype)
     x[:n] *= ramp
     x[len(x) - n:] *= ramp[::-1]
     return x
@@ -116,6 +127,6 @@ def fade(x: np.ndarray, rate: int) -> np.ndarray:
 
 def quantise(x: np.ndarray) -> np.ndarray:
     """16-bit samples, both channels scaled by one factor (the balance kept) to peak at PEAK: never clipped."""
-    top = np.abs(x).max()
-    scale = PEAK * 32767 / top if top > 0 else 0.0
-    return np.round(x * scale).astype("<i2")
+    top = float(np.abs(x).max())
+    x *= PEAK * 32767 / top if top > 0 else 0.0
+    return np.rint(x, out=x).astype("<i2")

@@ -29,6 +29,7 @@ import shutil
 import sys
 from pathlib import Path
 
+from . import audio
 from .encode import AUDIO_KBPS, QUEUE_FRAMES
 from .errors import SceneError
 from .integrators import AUTO_DT, check_substeps
@@ -189,12 +190,15 @@ def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
     gif = gif_frames(scene) * gif_pixels(scene) * GIF_BUFFER_BYTES_PER_PIXEL if "gif" in v.formats else 0
     # A comparison keeps every variant's state at every frame until its panels are drawn (render/split.py).
     kept = len(scene.compare[0][1]) * scene.frames * n * d * 8 if scene.compare else 0
+    sound = audio.peak_bytes(scene) if audio.heard(scene) else 0  # made whole once the frames are done
     terms = {"pendulums.count": state, "video.width, video.height": canvas + queued,
-             "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept}
-    return sum(terms.values()), max(terms, key=terms.get), (
-        f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
-        f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
-                                                   if kept else ""))
+             "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept,
+             "video.duration": sound}
+    detail = (f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
+              f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
+                                                         if kept else ""))
+    detail += f", the audio track being made {size(sound)}" if sound else ""
+    return sum(terms.values()), max(terms, key=terms.get), detail
 
 
 def output(scene, system, simulate: bool) -> tuple[int, str, str]:
@@ -209,7 +213,7 @@ def output(scene, system, simulate: bool) -> tuple[int, str, str]:
         sizes["mp4"] = int(scene.frames * v.width * v.height * MP4_BYTES_PER_PIXEL)
     if "gif" in v.formats:
         sizes["gif"] = int(gif_frames(scene) * gif_pixels(scene) * GIF_BYTES_PER_PIXEL)
-    if scene.has("audio") and "mp4" in v.formats:  # the MP4's AAC track: its bit rate, with room to spare
+    if audio.heard(scene):  # the MP4's AAC track: its bit rate, with room to spare
         sizes["audio"] = int(2 * v.duration * AUDIO_KBPS * 125)
     return sum(sizes.values()), "video.duration", ", ".join(f"{k} {size(b)}" for k, b in sizes.items())
 

@@ -278,7 +278,7 @@ class Encoder:
                "-c:v", "copy", "-c:a", AUDIO_CODEC, "-ar", str(AUDIO_RATE), "-b:a", f"{AUDIO_KBPS}k",
                "-movflags", "+faststart", "-f", "mp4", tmp]
         try:  # run() kills ffmpeg if we are interrupted while it works
-            code = subprocess.run(cmd, input=np.ascontiguousarray(samples, "<i2").tobytes(),
+            code = subprocess.run(cmd, input=memoryview(np.ascontiguousarray(samples, "<i2")).cast("B"),
                                   stdout=subprocess.DEVNULL, stderr=t.log, start_new_session=True).returncode
             if code:
                 raise self._failure("failed adding the audio", f"exit status {code}")

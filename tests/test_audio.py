@@ -63,8 +63,10 @@ def test_the_mp4_has_one_aac_stereo_stream_as_long_as_the_video(rendered):
     assert meta["audio"] == {"codec": "aac", "rate": 48000, "channels": 2, "bitrate_kbps": 128, "voices": 24,
                              "left": "theta1", "right": "theta2", "pitch_hz": [220.0, 880.0]}
     assert sorted(p.name for p in mp4.parent.iterdir()) == ["metadata.json", mp4.name]  # no sound file beside
-    sizes = budget.output(scene, registry.get(scene.system), False)
+    system = registry.get(scene.system)
+    sizes = budget.output(scene, system, False)
     assert "audio" in sizes[2] and meta["outputs"][mp4.name] < sizes[0]
+    assert "the audio track being made" in budget.memory(scene, system, False)[2]
 
 
 def spectrum_shape(x: np.ndarray) -> tuple[float, float]:
