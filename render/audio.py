@@ -15,7 +15,7 @@ import numpy as np
 
 from .encode import AUDIO_CODEC, AUDIO_KBPS, AUDIO_RATE
 
-VOICES = 64  # pendulums heard: a dense cluster once apart; the cost grows with these, not with the fan
+VOICES = 64  # pendulums heard: a dense cluster once apart; synthesis costs grow with these, not with the fan
 LOW_HZ, OCTAVES = 220.0, 2.0  # a hanging link sings A3, an upright one A5
 LEVEL_S = 0.25  # the loudness is evened out over blocks this long (see level)
 FADE_S = 0.02  # raised-cosine fades at both ends: no click where the track starts and stops
@@ -76,8 +76,8 @@ def synthesise(angles: np.ndarray, fps: int, rate: int = AUDIO_RATE) -> tuple[in
     Every frame gets the same whole number of samples, so the work is whole arrays (frames, voices, 2,
     samples) with no gathering: the rate is the next multiple of fps at or above `rate` (48000 itself at
     the fps that divide it: 60, 50, 30, 25, 24 ...), and ffmpeg resamples the others to `rate`. Float32
-    within a frame (twice as fast), where the phase grows by at most 2π·880/fps (92 rad at 60 fps: an error
-    below 1e-5 rad); float64 for the phases at frame starts, which sum the whole track."""
+    (half the memory) within a frame, where the phase grows by at most 2π·880/fps (92 rad at 60 fps: an
+    error below 1e-5 rad); float64 for the phases at frame starts, which sum the whole track."""
     frames, voices = angles.shape[:2]
     per = -(-rate // fps)
     hz = pitch(angles)
@@ -110,7 +110,7 @@ def level(x: np.ndarray, rate: int) -> np.ndarray:
     for c in range(x.shape[1]):
         col = x[:, c]
         rms = np.sqrt(np.add.reduceat(col * col, starts, dtype=np.float64) / sizes)
-        gain = 1 / np.maximum(rms, 1e-3 * rms.max())  # a block of near silence is not blown up into noise
+        gain = 1 / np.maximum(rms, max(1e-3 * rms.max(), 1e-12))  # near silence is not blown up into noise
         for a in range(0, n, CHUNK):  # in pieces: an hour's track is 173M samples
             col[a:a + CHUNK] *= np.interp(np.arange(a, min(a + CHUNK, n)), centres, gain)
     return x

@@ -21,7 +21,7 @@ from render.scene import load
 FFMPEG = imageio_ffmpeg.get_ffmpeg_exe()  # the bundle has no ffprobe: ffmpeg -i describes the streams
 # rigid_chaos, small: 24 pendulums 1e-3 rad apart over the fan part at about 3.5 s (the preset's 100
 # pendulums 1e-4 apart take 4 to 8 s), within a 6 s video.
-SMALL = ["video.width=320", "video.height=180", "video.fps=30", "video.duration=6", "pendulums.count=24",
+SMALL = ["video.width=256", "video.height=144", "video.fps=20", "video.duration=6", "pendulums.count=24",
          "pendulums.spread=1e-3", 'video.formats=["mp4"]']
 WINDOW = 2048  # samples (43 ms): short enough that one voice's glide stays within a few bins
 
