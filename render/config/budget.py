@@ -29,7 +29,8 @@ import shutil
 import sys
 from pathlib import Path
 
-from ..video.encode import QUEUE_FRAMES
+from ..video import audio
+from ..video.encode import AUDIO_KBPS, QUEUE_FRAMES
 from ..errors import SceneError
 from ..physics.integrators import AUTO_DT, check_substeps
 from ..physics.keys import BUDGET_MAX
@@ -189,12 +190,15 @@ def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
     gif = gif_frames(scene) * gif_pixels(scene) * GIF_BUFFER_BYTES_PER_PIXEL if "gif" in v.formats else 0
     # A comparison keeps every variant's state at every frame until its panels are drawn (render/draw/split.py).
     kept = len(scene.compare[0][1]) * scene.frames * n * d * 8 if scene.compare else 0
+    sound = audio.peak_bytes(scene) if audio.heard(scene) else 0  # made whole once the frames are done
     terms = {"pendulums.count": state, "video.width, video.height": canvas + queued,
-             "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept}
-    return sum(terms.values()), max(terms, key=terms.get), (
-        f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
-        f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
-                                                   if kept else ""))
+             "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept,
+             "video.duration": sound}
+    detail = (f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
+              f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
+                                                         if kept else ""))
+    detail += f", the audio track being made {size(sound)}" if sound else ""
+    return sum(terms.values()), max(terms, key=terms.get), detail
 
 
 def output(scene, system, simulate: bool) -> tuple[int, str, str]:
@@ -209,6 +213,8 @@ def output(scene, system, simulate: bool) -> tuple[int, str, str]:
         sizes["mp4"] = int(scene.frames * v.width * v.height * MP4_BYTES_PER_PIXEL)
     if "gif" in v.formats:
         sizes["gif"] = int(gif_frames(scene) * gif_pixels(scene) * GIF_BYTES_PER_PIXEL)
+    if audio.heard(scene):  # the MP4's AAC track: its bit rate, with room to spare
+        sizes["audio"] = int(2 * v.duration * AUDIO_KBPS * 125)
     return sum(sizes.values()), "video.duration", ", ".join(f"{k} {size(b)}" for k, b in sizes.items())
 
 

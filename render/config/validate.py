@@ -33,7 +33,8 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
 }
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 # New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov")
+EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov",
+           "audio")  # audio: a stereo track in the MP4 (render/video/audio.py)
 PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/draw/canvas.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
 MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
@@ -328,6 +329,13 @@ class Validator:
         if pend["layout"] == "shell" and system not in section:
             self.fail("pendulums.layout", "'shell' starts pendulums on the section θ1 = 0 of a double pendulum's two "
                       f"angles, and this system has none (systems with two link angles: {', '.join(section)})")
+        if "audio" in eff and not cls.ANGLES:
+            self.fail("effects", "'audio' sings the link angles (left θ1, right θ2), and this system's state is "
+                      "not angles (systems with angles: " + ", ".join(n for n in SYSTEMS if registry.get(n).ANGLES)
+                      + ")")
+        if "audio" in eff and "fractal" in eff:
+            self.fail("effects", "'audio' sings the pendulums of a fan, and a map's are its pixels: it cannot be "
+                      "combined with 'fractal'")
         if "glow" in eff and not any(e in eff for e in keys.DRAWN):
             self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(keys.DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash

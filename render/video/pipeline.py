@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import audio
 from ..trust import certify, quality
 from ..physics import grid, registry, runtime
 from .atomic import digest, replacing, write_atomic
@@ -163,12 +164,17 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     src = open_source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
     scene, timings = src.scene, src.timings
     timings["encode"] = 0.0
+    voices = None
+    if audio.heard(scene):  # the `audio` effect: the fan's angles at every frame make the MP4's track
+        voices = audio.Voices(src.sim, scene.video.fps)
     with output_dir(scene.out_dir(out_root)) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video, scene.frames)
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
                 for f in range(scene.frames):
                     frame = src.next_frame()  # a new array: the encoder shares it, it does not copy
+                    if voices:
+                        voices.record()
                     if frame_hook:
                         frame_hook(f, frame)
                     t = time.perf_counter()
@@ -176,7 +182,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()
-            sizes = enc.close()
+            sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
             timings["encode"] += time.perf_counter() - t
         except BaseException:
             enc.abort()
@@ -191,6 +197,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             meta["map"] = src.canvas.summary()
         if scene.has("poincare"):
             meta["poincare"] = src.canvas.section.summary()
+        if voices:
+            meta["audio"] = voices.summary()
         write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
