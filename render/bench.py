@@ -63,13 +63,15 @@ LOAD_AT_START: list[float] = [math.nan] * 3
 
 
 def add_parser(sub):
-    p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal",
-                       description="Measure simulation throughput (Taichi vs numpy), drawing and encoding fps, "
-                                   "an end-to-end render against the encode-only floor, and the fractal maps; "
+    p = sub.add_parser("bench", help="performance report: simulate, draw, encode, end to end, fractal, peers",
+                       description="Measure simulation throughput (Taichi vs numpy and numba, and its share of "
+                                   "the machine's peak flop rate), drawing and encoding fps, the HUD, an "
+                                   "end-to-end render against the encode-only floor, the matplotlib peer, and "
+                                   "the fractal maps, each ratio over interleaved rounds with its spread; "
                                    "write OUT/report.md, OUT/report.json and OUT/rates.json: this machine's rates, "
                                    "from which `render --out DIR` estimates its run time when they are "
                                    "DIR/bench/rates.json (the default out/bench serves the default out).")
-    p.add_argument("--quick", action="store_true", help="small N ladder and short videos (about 30 s)")
+    p.add_argument("--quick", action="store_true", help="small N ladder, short videos, 2 rounds (a few minutes)")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
     p.add_argument("--repeat", type=lambda t: positive_int(t, MAX_ROUNDS), metavar="R",
