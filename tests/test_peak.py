@@ -33,3 +33,47 @@ def test_peak_timer_gives_a_rate_from_runs_of_at_least_min_s():
     r = rate()
     assert np.isfinite(r) and r > 0
 
+
+
+COUNT_IR = r"""
+import json, pathlib, sys
+import taichi as ti
+from render import pipeline
+from render.scene import load
+out = {}
+for prec, sets in json.loads(sys.argv[1]):
+    ti.init(arch=ti.cpu, default_fp=ti.f64 if prec == "f64" else ti.f32, fast_math=False, offline_cache=False,
+            print_kernel_llvm_ir_optimized=True, log_level=ti.ERROR)  # runtime.init's settings, and the IR
+    before = set(pathlib.Path().glob("*.ll"))
+    scene = load("rigid_chaos", ["pendulums.count=64", 'integrator.method="rk4"', f'integrator.precision="{prec}"',
+                                 'effects=["bobs"]'] + sets)
+    sim = pipeline.make_system(scene)
+    sim.advance(1, sim.h)
+    ti.sync()
+    ir = max(set(pathlib.Path().glob("*.ll")) - before, key=lambda p: p.stat().st_size).read_text()
+    body = ir[ir.index("\nvector.body:"):]
+    body = body[:body.index("\n\n")]  # the vectorised loop over a group's columns: one substep, W columns
+    out[f"{prec} {sets}"] = sum(body.count(f"= {op} ") for op in ("fadd", "fsub", "fmul", "fdiv"))
+print(json.dumps(out))
+"""
+
+
+def test_rigid_flop_count_is_the_arithmetic_of_the_compiled_step(tmp_path):
+    """Each vector instruction of the vectorised RK4 loop does one flop per pendulum: their count is the flops of
+    one pendulum's step, as rigid_rk4_flops says, with unit constants (rigid_chaos) and without."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    other = ["pendulums.lengths=[1.2, 0.8]", "pendulums.masses=[1.5, 0.7]"]
+    cases = [(p, s) for p in ("f64", "f32") for s in ([], other)]
+    root = Path(__file__).resolve().parent.parent
+    r = subprocess.run([sys.executable, "-c", f"import sys; sys.path.insert(0, {str(root)!r})\n" + COUNT_IR,
+                        json.dumps(cases)], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    got = json.loads(r.stdout.strip().splitlines()[-1])
+    want = {f"{p} {s}": peak.rigid_rk4_flops(p, *(((1.2, 0.8), (1.5, 0.7)) if s else ((1.0, 1.0), (1.0, 1.0))))
+            for p, s in cases}
+    assert got == want
+    assert want == {"f64 []": 572, f"f64 {other}": 600, "f32 []": 356, f"f32 {other}": 384}
