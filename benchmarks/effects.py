@@ -5,7 +5,9 @@
 Each row adds one effect to the row above and reports ms per frame at the preset's 1280x720, 60 fps, so the
 difference between rows is what that effect costs. Times are medians of per-frame times after a warm-up
 that pays for kernel compilation; each row is measured --repeat times, round-robin, keeping the fastest
-median, since a 2-core machine is noisy at the 0.5 ms level. On a machine others are using, wall times
+median, since a 2-core machine is noisy at the 0.5 ms level. The noise of a row is the range of its totals
+over the rounds; a difference between two rows no larger than the noise of either is shown as "±", not as
+a number (with --repeat 1 there is no noise to tell, and every difference is shown). On a machine others are using, wall times
 measure the load; `--clock cpu` runs Taichi on one thread and times each frame in CPU time of this process
 (time.process_time), which time-sharing does not inflate: the cost of a frame, not how long it waited.
 
@@ -72,16 +74,31 @@ def measure(preset: str, effects: list[str], frames: int, cpu: bool = False) -> 
             "kernels": len(runtime.launched)}
 
 
+def total(r: dict) -> float:
+    return r["sim"] + r["draw"]
+
+
+def best(runs: list[dict]) -> dict:
+    """A row's fastest round, with its noise: the range of its totals over the rounds."""
+    return {**min(runs, key=total), "noise": max(map(total, runs)) - min(map(total, runs))}
+
+
+def added(r: dict, prev: dict | None) -> str:
+    """What the row's last effect adds: blank for a scene's first row, "±" within the noise of either row."""
+    if prev is None or prev["preset"] != r["preset"]:
+        return ""
+    d = total(r) - total(prev)
+    return "±" if abs(d) <= max(r["noise"], prev["noise"]) else f"{d:+.2f}"
+
+
 def table(rows: list[dict]) -> str:
     out = ["| scene | effects | simulate ms/frame | draw ms/frame | total ms/frame | added by the last effect | "
-           "field MB | kernels |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+           "noise ms/frame | field MB | kernels |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     prev = None
     for r in rows:
-        total = r["sim"] + r["draw"]
-        delta = "" if prev is None or prev["preset"] != r["preset"] else f"{total - prev['sim'] - prev['draw']:+.2f}"
         effects = ", ".join(r["effects"]) if r["effects"] != ["energy"] else "energy only (no drawing)"
-        out.append(f"| {r['preset']} | {effects} | {r['sim']:.2f} | {r['draw']:.2f} | {total:.2f} | {delta} | "
-                   f"{r['fields'] / 1e6:.1f} | {r['kernels']} |")
+        out.append(f"| {r['preset']} | {effects} | {r['sim']:.2f} | {r['draw']:.2f} | {total(r):.2f} | "
+                   f"{added(r, prev)} | {r['noise']:.2f} | {r['fields'] / 1e6:.1f} | {r['kernels']} |")
         prev = r
     return "\n".join(out)
 
@@ -96,7 +113,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     configs = [(p, e) for p, ladder in LADDERS.items() for e in ladder]
     rounds = [[measure(p, e, args.frames, args.clock == "cpu") for p, e in configs] for _ in range(args.repeat)]
-    rows = [min(runs, key=lambda r: r["sim"] + r["draw"]) for runs in zip(*rounds)]
+    rows = [best(list(runs)) for runs in zip(*rounds)]
     text = table(rows)
     print(text)
     if args.out:

@@ -1,23 +1,40 @@
-"""`pendulum bench --quick` writes its report; the fractal preset renders (small) one pendulum per pixel."""
+"""`pendulum bench --quick` writes its report, its ratios from interleaved rounds with their spread; the fractal
+preset renders (small) one pendulum per pixel."""
 import json
 import math
+import sys
+from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
 import pytest
 
 from conftest import run_cli
-from render.commands import peers
+from render.commands import bench, cli, peers
 from render.video import pipeline
 from render.config.scene import load
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+import effects  # noqa: E402  (benchmarks/effects.py)
+
 KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_peak_mem_mb",
-        "rainbow_1000_draw_fps", "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s")
+        "rainbow_1000_draw_fps", "draw_fps", "encode_fps", "end_to_end_s", "encode_floor_s", "hud_ms_720p",
+        "matplotlib_draw_ratio", "peak_gflops.f64", "peak_gflops.f32", "rigid_rk4_peak_fraction.f64",
+        "rigid_rk4_peak_fraction.f32")
 TARGETS = {"end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps.flip_time", "fractal_peak_mem_mb",
            "rainbow_1000_draw_fps", "sim_speedup_vs_numba_1e5", "rigid_f64_steps_per_s_1e5",
            "rigid_f32_steps_per_s_1e5", "elastic_speedup_vs_numpy_1e5", "render_over_realtime",
-           "matplotlib_peer_ratio"}
+           "matplotlib_peer_ratio", "hud_ms_720p", "matplotlib_draw_ratio", "fractal_fps.divergence",
+           "rigid_rk4_peak_fraction.f64", "rigid_rk4_peak_fraction.f32"}
 PEER_KEYS = ("sim_speedup_vs_numba_1e5", "elastic_speedup_vs_numba_1e5")  # null without numba
+RATIOS = ("sim_speedup_vs_numpy_1e5", "elastic_speedup_vs_numpy_1e5", "matplotlib_peer_ratio", "matplotlib_draw_ratio",
+          "rigid_rk4_peak_fraction.f64", "rigid_rk4_peak_fraction.f32")  # each with its spread over the rounds
+
+
+def at(rep, key):
+    for k in key.split("."):
+        rep = rep[k]
+    return rep
 
 
 @pytest.mark.slow
@@ -27,14 +44,20 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
     assert r.returncode == 0, r.stderr
     rep = json.loads((out / "report.json").read_text())
     for key in KEYS:
-        val = rep[key]
+        val = at(rep, key)
         assert isinstance(val, (int, float)) and not isinstance(val, bool), (key, val)
         assert math.isfinite(val) and val > 0, (key, val)
     # DESIGN.md: fractal_fps per colouring, as a dict; each map rendered at 720p
     assert set(rep["fractal_fps"]) == {"angles", "flip_time", "divergence", "lyapunov"}
     assert all(math.isfinite(v) and v > 0 for v in rep["fractal_fps"].values()), rep["fractal_fps"]
     assert all(f["map"]["plot"]["width"] > 600 for f in rep["fractal"].values())
-    assert rep["quick"] is True
+    assert rep["quick"] is True and rep["rounds"] == 2
+    assert rep["machine"]["cpu_kind"] in ("avx2", "avx512") and len(rep["machine"]["load_avg_end"]) == 3
+    for key in RATIOS:  # the value is the medians' ratio; the rounds' own ratios lie around it
+        s = rep["spread"][key]
+        assert s["rounds"] == 2 and s["min"] <= s["max"] and s["spread_pct"] >= 0, (key, s)
+        assert s["value"] == pytest.approx(at(rep, key)), key
+    assert 0 < rep["rigid_rk4_peak_fraction"]["f64"] < 1.5  # of a peak measured on the same cores
     assert set(rep["targets"]) == TARGETS
     for key, t in rep["targets"].items():  # a peer that did not run (numba not installed) is null, not a miss
         assert isinstance(t["met"], bool) or (t["met"] is None and t["value"] is None and key in PEER_KEYS), (key, t)
@@ -48,7 +71,7 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
         assert s["agree"] < (1e-9 if s["precision"] == "f64" else 1e-3), s
     md = (out / "report.md").read_text()
     assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md and "| flip_time | fractal_flip |" in md
-    assert "## rainbow_1000" in md
+    assert "## rainbow_1000" in md and "fraction of peak" in md and "range over 2 rounds" in md
     assert not list(out.glob(".*")), "temporary files left behind"
 
 
@@ -107,3 +130,102 @@ def test_serial_and_parallel_drawing_give_the_same_bytes(tmp_path):
                         frame_hook=lambda f, fr: frames.append(fr.tobytes()))
         runs.append(frames)
     assert runs[0] == runs[1]
+
+
+def test_interleaved_rounds_take_each_side_in_turn():
+    calls = []
+
+    def side(name, rates):
+        it = iter(rates)
+        return lambda: (calls.append(name), next(it))[1]
+    runs = peers.interleave({"ours": side("ours", [10, 12, 20]), "peer": side("peer", [5, 4, 5])}, 3)
+    assert calls == ["ours", "peer"] * 3
+    assert runs == {"ours": [10, 12, 20], "peer": [5, 4, 5]}
+    r = peers.ratio(runs["ours"], runs["peer"])  # medians 12 / 5; the rounds' ratios 2, 3, 4
+    assert r == {"value": pytest.approx(2.4), "min": 2.0, "max": 4.0, "spread_pct": pytest.approx(100 * 2 / 2.4),
+                 "rounds": 3}
+    assert peers.ratio([1.0], None) is None  # a peer that did not run
+    assert bench.spread_text(r) == "2..4 (83 %)" and bench.with_spread(r) == "**2.40** (2.00..4.00 (83 %))"
+
+
+def fake_results(numba=True):
+    """What the phases return, small and made up, for the report alone (no phase runs)."""
+    rows = []
+    for system in ("rigid", "elastic"):
+        for prec in ("f32", "f64"):
+            for n in (100, 10**5):
+                runs = {"taichi": [4e7, 5e7, 6e7], "numpy": [2e6, 2.5e6, 2e6], "numba": [1e7, 1e7, 1.2e7]}
+                rows.append({"system": system, "precision": prec, "n": n, "taichi": 5e7, "numpy": 2e6,
+                             "numba": 1e7 if numba and n == 10**5 else None, "speedup": 25.0, "agree": 1e-12,
+                             "vs": {"numpy": peers.ratio(runs["taichi"], runs["numpy"]),
+                                    "numba": peers.ratio(runs["taichi"], runs["numba"] if numba else None)}})
+    frac = peers.ratio([2e10, 3e10], [8e10, 1e11])
+    pk = {p: {"peak_gflops": 90.0, "rigid_rk4_gflops": 25.0, "flops_per_step": 600, "fraction": frac}
+          for p in ("f32", "f64")}
+    mpl = {"frames": 60, "ours_s": 2.0, "matplotlib_s": 7.0, "ours_draw_fps": 300.0, "matplotlib_draw_fps": 20.0,
+           "vs": {"render": peers.ratio([0.5, 0.5], [1 / 7, 1 / 7]), "draw": peers.ratio([300.0, 280.0], [20.0, 21.0])}}
+    fractal = {"wall_s": 2.0, "frames": 12, "duration_s": 0.2, "fps": 6.0,
+               "timings": {"certify": 0.1, "simulate": 1.0, "draw": 0.5, "encode": 0.2},
+               "integrator": {"method": "rk4", "dt": 2e-3, "substeps": 9, "precision": "f64"},
+               "map": {"plot": {"width": 640}, "events": 3, "events_trusted": 3}}
+    res = {"sim": {"rows": rows, "peak": pk}, "encode": {"draw_fps": 200.0, "sim_draw_fps": 180.0, "floor_s": 1.0,
+                                                         "encode_fps": 120.0},
+           "e2e": {"wall_s": 1.2, "frames": 120, "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4},
+                   "fixed_s": 0.3},
+           "hud": {"frames": 118, "ms": 0.8, "size": "1280x720"}, "matplotlib": mpl,
+           "rainbow": {"frames": 178, "draw_fps": 40.0, "sim_fps": 300.0, "size": "1280x720", "effects": ["rods"]},
+           **{f"fractal_{c}": {**fractal, "preset": p} for c, p in bench.FRACTALS.items()}}
+    for r in res.values():
+        r["peak_mem_mb"] = 100.0
+    return res
+
+
+@pytest.mark.parametrize("kind", ["avx2", "avx512"])
+def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monkeypatch, kind):
+    monkeypatch.setattr(bench, "cpu_kind", lambda: kind)
+    rep = bench.summarise(fake_results(), True, 1.0)
+    assert rep["machine"]["cpu_kind"] == kind and rep["rounds"] == 2
+    assert rep["hud_ms_720p"] == rep["hud_ms_per_frame"] == 0.8
+    assert rep["peak_gflops"] == {"f32": 90.0, "f64": 90.0} and rep["peak_flops_f64"] == 90e9
+    assert rep["rigid_rk4_peak_fraction"]["f64"] == pytest.approx(2.5 / 9)  # medians 2.5e10 / 9e10
+    assert rep["rigid_rk4_fraction_of_peak_f32"] == rep["rigid_rk4_peak_fraction"]["f32"]
+    assert rep["matplotlib_draw_ratio"] == pytest.approx(290 / 20.5) and rep["matplotlib_peer_ratio"] == 3.5
+    assert rep["spread"]["matplotlib_draw_ratio"]["min"] == pytest.approx(280 / 21)
+    assert rep["spread"]["sim_speedup_vs_numba_1e5"]["max"] == pytest.approx(6.0 / 1.2)
+    t = rep["targets"]
+    assert set(t) == TARGETS and t["matplotlib_draw_ratio"]["spread"] == rep["spread"]["matplotlib_draw_ratio"]
+    assert t["hud_ms_720p"] == {"value": 0.8, "goal": "<= 1", "met": True, "value_over_goal": 0.8, "spread": None}
+    goal, met, speedup = {"avx2": ("3.5e+07", True, "15"), "avx512": ("5.5e+07", False, "8")}[kind]
+    f64 = t["rigid_f64_steps_per_s_1e5"]  # 5e7 steps/s: past AVX2's 3.5e7, short of AVX-512's 5.5e7
+    assert f64["goal"] == f">= {goal}" and f64["met"] is met
+    assert t["sim_speedup_vs_numpy_1e5"]["goal"] == f">= {speedup}" and t["sim_speedup_vs_numpy_1e5"]["met"]
+    md = bench.markdown(rep)
+    assert "| matplotlib_draw_ratio | 14.1 | 13.3..15 (12 %) |" in md and "**0.278** (0.250..0.300 (18 %))" in md
+    assert f"{kind} targets" in md and "load average" in md
+
+
+def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):
+    rep = bench.summarise(fake_results(numba=False), True, 1.0)
+    for key in PEER_KEYS:
+        assert rep[key] is None and rep["spread"][key] is None
+    assert rep["targets"]["sim_speedup_vs_numba_1e5"]["met"] is None
+    assert "null" in bench.markdown(rep)
+
+
+def test_repeat_must_be_a_positive_count(capsys, tmp_path):
+    with pytest.raises(SystemExit) as e:
+        cli.main(["bench", "--repeat", "0", "--out", str(tmp_path / "b")])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and "--repeat" in err and "positive integer" in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())
+
+
+def test_effects_table_shows_a_difference_within_the_noise_as_plus_minus():
+    def run(effects, sim, draw):
+        return {"preset": "rigid_chaos", "effects": effects, "sim": sim, "draw": draw, "fields": 0, "kernels": 2}
+    bobs = effects.best([run(["bobs"], 1.0, 2.0), run(["bobs"], 1.0, 2.4)])  # 3.0 .. 3.4: noise 0.4
+    assert bobs["draw"] == 2.0 and bobs["noise"] == pytest.approx(0.4)
+    rods = effects.best([run(["bobs", "rods"], 1.0, 2.3), run(["bobs", "rods"], 1.0, 2.3)])  # +0.3: within it
+    trails = effects.best([run(["bobs", "rods", "trails"], 1.0, 4.0)] * 2)  # +1.7: beyond
+    text = effects.table([bobs, rods, trails]).splitlines()
+    assert [line.split(" | ")[5] for line in text[2:]] == ["", "±", "+1.70"]

@@ -23,8 +23,8 @@ def test_without_numba_the_peer_is_skipped_with_one_line_and_its_keys_are_null(m
     scene = bench_scene("rigid_chaos")
     q, v = (a.T.copy() for a in reference.initial_state(scene))
     never = lambda *a: pytest.fail("nothing to time")  # noqa: E731
-    assert peers.numba_rate(scene, q, v, 1e-3, 50, 0.1, never) is None
-    assert peers.numba_rate(scene, q, v, 1e-3, 50, 0.1, never) is None
+    assert peers.numba_timer(scene, q, v, 1e-3, 50, 0.1, never) is None
+    assert peers.numba_timer(scene, q, v, 1e-3, 50, 0.1, never) is None
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"bench: {peers.MISSING}"] and "pip install -e '.[bench]'" in err[0]
     keys = peers.throughput_keys(rows(None), render_s=10.0, video_s=20.0)

@@ -1,14 +1,20 @@
-"""The numba and matplotlib peers of `pendulum bench`, and the throughput keys of issue 17 they give.
+"""The numba and matplotlib peers of `pendulum bench`, the interleaved rounds that time them, and the keys
+of issues 17 and 27 they give.
 
 The peer is what a user would write in one page: @njit(parallel=True, fastmath=True), a prange over the
 pendulums, RK4 with the state in locals, math.sin / math.cos. It is an independent implementation of the
 rigid and elastic equations (as render/physics/reference.py is for numpy), run in the bench's sim phase, in the same
 process and the same run as the Taichi kernel it is compared with. numba is a bench-only extra
 (pip install -e '.[bench]'), never a runtime dependency: without it the numba keys are null.
+
+Every ratio against a peer comes from interleaved rounds: ours, the peer, ours again, ..., each side timed
+once per round, so that a load that comes and goes on a shared machine falls on both sides alike. A ratio is
+the ratio of the two sides' medians; its spread is the range of the ratios round by round.
 """
 from __future__ import annotations
 
 import math
+import statistics
 
 try:
     import numba
@@ -107,28 +113,62 @@ def numba_rk4(scene, dtype):
     return advance_elastic
 
 
+def interleave(sides: dict, rounds: int) -> dict[str, list[float]]:
+    """{side: [its rate in each round]}: each side's callable run once per round, in the dict's order."""
+    runs = {name: [] for name in sides}
+    for _ in range(rounds):
+        for name, once in sides.items():
+            runs[name].append(once())
+    return runs
+
+
+def ratio(ours: list[float], peer: list[float] | None) -> dict | None:
+    """ours over peer (rates, one per round): the medians' ratio, the range of the per-round ratios, and
+    that range as % of the ratio; None when the peer did not run."""
+    if not peer:
+        return None
+    per = [a / b for a, b in zip(ours, peer)]
+    value = statistics.median(ours) / statistics.median(peer)
+    return {"value": value, "min": min(per), "max": max(per), "spread_pct": 100.0 * (max(per) - min(per)) / value,
+            "rounds": len(per)}
+
+
 def throughput_keys(rows: list[dict], render_s: float, video_s: float, mpl: dict | None = None) -> dict:
     """Issue 17's report keys from the sim phase's rows at N = 1e5, the timed rigid_chaos render and the
-    matplotlib phase; a ratio against a peer that did not run (numba missing) is null. The rows come in bench.SIM_PRESETS' order: the
-    rigid pendulum's system first, then the elastic one's."""
+    matplotlib phase; a ratio against a peer that did not run (numba missing) is null. The rows come in
+    bench.SIM_PRESETS' order: the rigid pendulum's system first, then the elastic one's. Their spreads are
+    in spreads()."""
     rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
     at = {(r["system"], r["precision"]): r for r in rows if r["n"] == 10**5}
 
-    def ratio(system, peer):
+    def ratio_of(system, peer):
         r = at.get((system, "f64"))
         return r["taichi"] / r[peer] if r and r.get(peer) else None
-    return {"sim_speedup_vs_numba_1e5": ratio(rigid, "numba"),
+    return {"sim_speedup_vs_numba_1e5": ratio_of(rigid, "numba"),
             "rigid_f64_steps_per_s_1e5": at[(rigid, "f64")]["taichi"],
             "rigid_f32_steps_per_s_1e5": at[(rigid, "f32")]["taichi"],
-            "elastic_speedup_vs_numpy_1e5": ratio(elastic, "numpy"),
-            "elastic_speedup_vs_numba_1e5": ratio(elastic, "numba"),
+            "elastic_speedup_vs_numpy_1e5": ratio_of(elastic, "numpy"),
+            "elastic_speedup_vs_numba_1e5": ratio_of(elastic, "numba"),
             "render_over_realtime": render_s / video_s,
             "matplotlib_peer_ratio": mpl["matplotlib_s"] / mpl["ours_s"] if mpl else None}
 
 
-def numba_rate(scene, q, v, h: float, n: int, min_s: float, rate) -> float | None:
-    """The numba peer's pendulum-substeps per second from the bench's (D, N) initial state, timed by the
-    bench's `rate`; None (and one line on stderr) without numba."""
+def spreads(rows: list[dict], mpl: dict | None = None) -> dict:
+    """{report key: ratio()} for the keys of throughput_keys (and the bench's own) that compare with a peer."""
+    rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
+    at = {(r["system"], r["precision"]): r.get("vs", {}) for r in rows if r["n"] == 10**5}
+    out = {"sim_speedup_vs_numpy_1e5": at[(rigid, "f64")].get("numpy"),
+           "sim_speedup_vs_numba_1e5": at[(rigid, "f64")].get("numba"),
+           "elastic_speedup_vs_numpy_1e5": at[(elastic, "f64")].get("numpy"),
+           "elastic_speedup_vs_numba_1e5": at[(elastic, "f64")].get("numba")}
+    if mpl:
+        out["matplotlib_peer_ratio"], out["matplotlib_draw_ratio"] = mpl["vs"]["render"], mpl["vs"]["draw"]
+    return out
+
+
+def numba_timer(scene, q, v, h: float, n: int, min_s: float, timer):
+    """The numba peer timed from the bench's (D, N) initial state: the bench's `timer` over its advance (a
+    callable giving pendulum-substeps per second of one run); None (and one line on stderr) without numba."""
     import sys
 
     import numpy as np
@@ -140,34 +180,27 @@ def numba_rate(scene, q, v, h: float, n: int, min_s: float, rate) -> float | Non
             _said.append(True)
         return None
     qn, vn, hn = np.ascontiguousarray(q.T, dtype), np.ascontiguousarray(v.T, dtype), dtype.type(h)
-    return rate(lambda k: advance(qn, vn, k, hn), n, min_s)  # rate's first call compiles
+    return timer(lambda k: advance(qn, vn, k, hn), n, min_s)  # the timer's first call compiles
 
 
 _said: list = []
 
 
-def matplotlib_render(scene, out_file) -> float:
-    """The matplotlib peer: the scene's frames as a user would make them, a FuncAnimation over numpy RK4
-    (render/physics/reference.py) drawing rods, bobs and 1 s trails with Agg at the scene's size, saved as MP4 by
-    ffmpeg at this project's x264 settings. Returns its wall time in s (simulation included)."""
-    import time
-
-    import imageio_ffmpeg
+def matplotlib_figure(scene):
+    """The matplotlib peer as a user would write it: numpy RK4 (render/reference.py) and rods, bobs and 1 s
+    trails as three artist collections, drawn by Agg at the scene's size. Returns (figure, frame(f)): frame f
+    moves the artists to frame f (stepping the simulation one frame on from the previous f)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    from matplotlib.animation import FFMpegWriter, FuncAnimation
     from matplotlib.collections import LineCollection
 
     from ..physics import reference, registry
-    from ..video.encode import MP4_CRF, MP4_PRESET
 
-    t0 = time.perf_counter()
     plan = registry.get(scene.system)(scene, allocate=False)  # the step and the initial state, no Taichi
     q, v = (a.T.copy() for a in reference.initial_state(scene))
     v_ = scene.video
-    matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
     fig = plt.figure(figsize=(v_.width / 100, v_.height / 100), dpi=100, facecolor="black")
     ax = fig.add_axes((0, 0, 1, 1), facecolor="black")
     reach = 1.1 * plan.reach()
@@ -196,9 +229,44 @@ def matplotlib_render(scene, out_file) -> float:
         trails.set_segments(np.stack(history, axis=1))
         bobs.set_offsets(pts.reshape(-1, 2))
         return rods, trails, bobs
+    return fig, frame
 
-    writer = FFMpegWriter(fps=v_.fps, codec="libx264",
+
+def matplotlib_render(scene, out_file) -> float:
+    """The matplotlib peer's frames by FuncAnimation, saved as MP4 by ffmpeg at this project's x264 settings.
+    Returns its wall time in s (simulation included)."""
+    import time
+
+    import imageio_ffmpeg
+    import matplotlib
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FFMpegWriter, FuncAnimation
+
+    from ..video.encode import MP4_CRF, MP4_PRESET
+
+    t0 = time.perf_counter()
+    fig, frame = matplotlib_figure(scene)
+    matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
+    writer = FFMpegWriter(fps=scene.video.fps, codec="libx264",
                           extra_args=["-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p"])
     FuncAnimation(fig, frame, frames=scene.frames, blit=False).save(str(out_file), writer=writer, dpi=100)
     plt.close(fig)
     return time.perf_counter() - t0
+
+
+def matplotlib_draw(scene) -> float:
+    """The peer's frames drawn and nothing encoded: per frame what its writer does before piping to ffmpeg
+    (canvas.draw, then the RGBA buffer read). Frames per second, the simulation included as in ours."""
+    import time
+
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    t0 = time.perf_counter()
+    fig, frame = matplotlib_figure(scene)
+    for f in range(scene.frames):
+        frame(f)
+        fig.canvas.draw()
+        np.asarray(fig.canvas.buffer_rgba())  # the H×W×4 frame a writer would take
+    plt.close(fig)
+    return scene.frames / (time.perf_counter() - t0)
