@@ -267,6 +267,12 @@ class Font(runtime.Launcher):
             self._glyph(target, glyphs, i, over, tiles, mark, True)
 
     @ti.func
+    def glyph_max(self, out: ti.template(), glyphs: ti.template(), i):
+        """Row i of `glyphs` into a uint8 target with a max, as draw_glyphs draws it. It writes only inside
+        its own cell, and the cells of one line do not overlap: one thread per glyph of a line is no race."""
+        self._glyph(out, glyphs, i, False, out, False, False)
+
+    @ti.func
     def _glyph(self, out: ti.template(), glyphs: ti.template(), i, over: ti.template(), tiles: ti.template(),
                mark: ti.template(), field: ti.template()):
         """One glyph, clipped: rows of the cell, then the lit font pixels of a row, each scale pixels wide."""
