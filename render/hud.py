@@ -41,8 +41,8 @@ AMBER, RED, CURVE = (1.0, 0.72, 0.2), (1.0, 0.34, 0.3), (0.45, 0.85, 1.0)
 LOG_LO, LOG_HI = -8.0, 0.5  # the spread axis: log10(spread / reach); neighbours are at most 2 reaches apart
 UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 # Up to this many threads the HUD's loops run on the launching thread: they write a few thousand pixels, less
-# work than waking the thread pool for each loop (rigid_chaos, 720p, 2 threads: 0.8 ms a frame serial, 2.9 ms
-# in parallel, on a loaded machine). Either way each pixel has one writer, so the bytes are the same.
+# work than waking the thread pool for each of them (rigid_chaos, 720p, 2 threads, a busy 2-core machine: 0.8 ms
+# a frame so, 1.4 ms with the pool). Either way each pixel has one writer, so the bytes are the same.
 SERIAL_MAX_THREADS = 4
 
 
@@ -144,17 +144,14 @@ class Hud(runtime.Launcher):
     # ------------------------------------------------------------ host-side layout
     def bake(self, rows: list):
         """The text that never changes, drawn once (by the font's kernel, in order) into a blank frame, as its
-        lit pixels: (y·w + x, r | g << 8 | b << 16), for hud_draw to max into every frame. Returns the field and
-        how many there are."""
+        lit pixels: y, x, r, g, b, for hud_draw to max into every frame. Returns the field and how many."""
         img = np.zeros((self.h, self.w, 3), np.uint8)
         if rows:
             self.font.draw_glyphs(img, np.concatenate(rows))
-        flat = img.reshape(-1, 3)
-        lit = np.flatnonzero(flat.any(1))
-        pixels = np.stack([lit, flat[lit].astype(np.int32) @ np.array([1, 256, 65536], np.int32)], 1)
-        layer = runtime.field("hud.layer", ti.i32, (max(len(lit), 1), 2))  # a field has at least one row
-        layer.from_numpy(pixels.astype(np.int32) if len(lit) else np.zeros((1, 2), np.int32))
-        return layer, len(lit)
+        y, x = np.nonzero(img.any(2))
+        layer = runtime.field("hud.layer", ti.i32, (max(len(y), 1), 5))  # a field has at least one row
+        layer.from_numpy(np.column_stack([y, x, img[y, x]]).astype(np.int32) if len(y) else np.zeros((1, 5), np.int32))
+        return layer, len(y)
 
     def cell(self, size, scale):
         return text_width("x", scale, size), self.font.text_height("x", scale, size)
@@ -236,9 +233,10 @@ class Hud(runtime.Launcher):
         pixel by pixel, each line of text glyph by glyph (a line's cells do not overlap), the graph column
         by column. So the bytes are the same at any thread count, serial or not."""
         ti.loop_config(serialize=self.serial)
-        for i in range(self.lit):
-            p, c = self.layer[i, 0], self.layer[i, 1]
-            self.put_bytes(out, p // self.w, p % self.w, ti.Vector([c & 255, (c >> 8) & 255, c >> 16]))
+        for i in range(self.lit):  # inside the frame: it was drawn there
+            y, x = self.layer[i, 0], self.layer[i, 1]
+            for k in ti.static(range(3)):
+                out[y, x, k] = ti.cast(ti.max(ti.cast(out[y, x, k], ti.i32), self.layer[i, 2 + k]), ti.u8)
         ti.loop_config(serialize=self.serial)
         for i in range(clock):
             self.font.glyph_max(out, glyphs, i)
