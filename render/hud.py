@@ -149,8 +149,9 @@ class Hud(runtime.Launcher):
         if rows:
             self.font.draw_glyphs(img, np.concatenate(rows))
         y, x = np.nonzero(img.any(2))
+        pixels = np.column_stack([y, x, img[y, x]]).astype(np.int32)
         layer = runtime.field("hud.layer", ti.i32, (max(len(y), 1), 5))  # a field has at least one row
-        layer.from_numpy(np.column_stack([y, x, img[y, x]]).astype(np.int32) if len(y) else np.zeros((1, 5), np.int32))
+        layer.from_numpy(pixels if len(y) else np.zeros((1, 5), np.int32))
         return layer, len(y)
 
     def cell(self, size, scale):
@@ -201,7 +202,7 @@ class Hud(runtime.Launcher):
     def draw(self, out: np.ndarray, t: float):
         """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
         frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
-        spread = self.launch("hud_spread", frame) if self.fan else 0.0  # returned: no field read, no extra launch
+        spread = self.launch("hud_spread", frame) if self.fan else 0.0  # returned: no field read to launch
         clock = f"t = {t:5.2f} s"
         lines = [self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big, self.bs,
                            ha="right", va="bottom") if self.info.panel else
@@ -264,14 +265,10 @@ class Hud(runtime.Launcher):
 
     @ti.func
     def put(self, out: ti.template(), y, x, c):
-        self.put_bytes(out, y, x, ti.cast(c * 255.0 + 0.5, ti.i32))
-
-    @ti.func
-    def put_bytes(self, out: ti.template(), y, x, c):
         if 0 <= x < self.w and 0 <= y < self.h:
             for k in ti.static(range(3)):
                 old = ti.cast(out[y, x, k], ti.i32)  # (LLVM has no max of u8)
-                out[y, x, k] = ti.cast(ti.max(old, c[k]), ti.u8)
+                out[y, x, k] = ti.cast(ti.max(old, ti.cast(c[k] * 255.0 + 0.5, ti.i32)), ti.u8)
 
     @ti.func
     def column(self, out: ti.template(), x, y0, y1, c):
