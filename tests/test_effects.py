@@ -98,9 +98,9 @@ def test_the_hud_is_only_paid_for_when_asked_and_only_adds_light(tmp_path):
     assert hud_work(base["kernels"]) == [] and hud_work(base["fields"]) == []
     more, with_hud = render(tmp_path, effects=("rods", "bobs", "hud"))
     added = [k for k in more["kernels"] if k not in base["kernels"]]
-    assert sorted(added) == ["hud_graph", "text_bytes"], added
+    assert sorted(added) == ["hud_draw", "hud_spread", "text_bytes"], added  # text_bytes once, for the static text
     new_fields = set(more["fields"]) - set(base["fields"])
-    assert new_fields == {"hud.spread", "hud.history", "font.glyphs"}, new_fields
+    assert new_fields == {"hud.spread", "hud.history", "hud.layer", "font.glyphs"}, new_fields
     assert more["field_bytes"] - base["field_bytes"] == sum(more["fields"][f] for f in new_fields)
     # drawn over the finished frame with a max: the pendulums are all still there, and text was added
     assert (with_hud >= without).all() and (with_hud > without).any()

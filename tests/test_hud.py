@@ -1,5 +1,8 @@
 """The HUD: the clock says the simulated time and changes colour past the certificate's marks, the spread is
 the largest distance between neighbours' last bobs, it works for every system, and it stays in its corners."""
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -95,3 +98,41 @@ def test_a_single_pendulum_has_a_clock_and_a_timeline_but_no_spread():
     want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *hud.faces(H)[1])
     np.testing.assert_array_equal(frames[-1][box], want[box])
     assert frames[-1][h.gy1 + 1, h.gx0:h.x_of(0.4)].min() > 0  # the timeline, lit up to now
+
+
+SCRIPT = """
+import hashlib, sys
+import numpy as np
+from render import hud, pipeline, runtime
+from render.scene import load
+threads = int(sys.argv[1])
+for w, h, panel in ((1280, 720, False), (640, 360, True)):
+    scene = load("rigid_chaos", [f"video.width={w}", f"video.height={h}", "video.fps=60", "video.duration=0.5"])
+    runtime.init("cpu", "f64", threads)
+    sim = pipeline.make_system(scene)
+    info = hud.Info(scene.description, "rk4", 1e-3, "f64", faithful_until_s=0.15, median_until_s=0.3, panel=panel)
+    h_ = hud.Hud(scene, sim, info, w, h)
+    digest, lit = hashlib.sha256(), set()
+    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        out = np.zeros((h, w, 3), np.uint8)
+        out[::7, ::5] = 40  # something under the HUD for its max
+        h_.draw(out, f / 60)
+        digest.update(out.tobytes())
+        lit.add(int((out.max(2) > 40).sum()))
+    print(h_.serial, len(lit) > 1, digest.hexdigest())
+"""
+
+
+def test_the_hud_is_the_same_bytes_at_1_2_and_8_threads():
+    """Drawn alone at 720p and as a 360p panel, every frame of half a second: on the launching thread at 1 and 2
+    threads and by the thread pool at 8 (its loops give each pixel one writer), the same bytes."""
+    runs = {}
+    for threads in (1, 2, 8):
+        r = subprocess.run([sys.executable, "-c", SCRIPT, str(threads)], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        out = r.stdout.split()
+        runs[threads] = [out[k:k + 3] for k in (0, 3)]  # (serial, changes, digest) per size
+    for threads, sizes in runs.items():
+        assert [s[0] for s in sizes] == [str(threads <= hud.SERIAL_MAX_THREADS)] * 2, (threads, sizes)
+        assert [s[1] for s in sizes] == ["True"] * 2  # the picture changes from frame to frame
+    assert [s[2] for s in runs[1]] == [s[2] for s in runs[2]] == [s[2] for s in runs[8]], runs

@@ -30,7 +30,8 @@ Every call is one serial kernel launch over the glyphs of all its strings, in or
 frames are byte-identical whatever the thread count, later strings paint over earlier ones under "over",
 and colour arithmetic happens in f32 (fields) or integers (uint8 arrays) whatever Taichi's default_fp.
 Cost (benchmarks/font_cost.py): one Taichi launch per call, whatever the number of strings, plus about
-1 µs of host layout per glyph; draw a frame's whole HUD with one draw_many.
+1 µs of host layout per glyph; draw a frame's whole HUD with one draw_many. Another kernel can draw rows of
+layout() itself with glyph_max (a ti.func), one thread per glyph of a line, as render/hud.py does.
 """
 
 import base64
@@ -266,6 +267,12 @@ class Font(runtime.Launcher):
         ti.loop_config(serialize=True)
         for i in range(n):
             self._glyph(target, glyphs, i, over, tiles, mark, True)
+
+    @ti.func
+    def glyph_max(self, out: ti.template(), glyphs: ti.template(), i):
+        """Row i of `glyphs` into a uint8 target with a max, as draw_glyphs draws it. It writes only inside
+        its own cell, and the cells of one line do not overlap: one thread per glyph of a line is no race."""
+        self._glyph(out, glyphs, i, False, out, False, False)
 
     @ti.func
     def _glyph(self, out: ti.template(), glyphs: ti.template(), i, over: ti.template(), tiles: ti.template(),

@@ -17,9 +17,12 @@ small sizes (under 360 px) the certificate's words and the axis labels are left 
 clock's colour carry it. Everything is clipped to the frame.
 
 It draws into the finished uint8 frame, after the canvas composed it, so it is the same under max or glow
-compositing. Per frame: one kernel (the spread, its history and the graph, serial) and one text launch (the
-static text laid out once, the clock and the spread's value laid out per frame). The spread is a max (order
-independent) and everything drawn is drawn in order, so frames are byte-identical at any thread count.
+compositing. The text that never changes (the method, the step, the certificate, the caption, the axis labels)
+is drawn once, when the HUD is made, into a cached layer of lit pixels. Per frame: one small kernel for the
+spread (a max, order independent) and its history, and one that draws into the frame, every write a max:
+the cached layer pixel by pixel, the clock and the spread's value glyph by glyph (a line's cells do not
+overlap), the graph and the timeline column by column. Each pixel has one writer in each loop, so frames are
+byte-identical at any thread count, whether the loops run in parallel or (at few threads) serially.
 
 What it says beyond the drawing contract (the caption, the integrator, the certificate) comes in an Info,
 from pipeline.Source; the clock comes with each draw().
@@ -37,6 +40,10 @@ WHITE, DIM, FAINT = (0.92, 0.92, 0.92), (0.55, 0.55, 0.55), (0.22, 0.22, 0.22)
 AMBER, RED, CURVE = (1.0, 0.72, 0.2), (1.0, 0.34, 0.3), (0.45, 0.85, 1.0)
 LOG_LO, LOG_HI = -8.0, 0.5  # the spread axis: log10(spread / reach); neighbours are at most 2 reaches apart
 UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
+# Up to this many threads the HUD's loops run on the launching thread: they write a few thousand pixels, less
+# work than waking the thread pool for each of them (rigid_chaos, 720p, 2 threads, a busy 2-core machine: 0.8 ms
+# a frame so, 1.4 ms with the pool). Either way each pixel has one writer, so the bytes are the same.
+SERIAL_MAX_THREADS = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,6 +113,7 @@ class Hud(runtime.Launcher):
         self.ss, self.bs, self.ls = ss, bs, ls
         self.words = h >= 360  # room for the certificate's words and the axis labels
         self.font = Font(self.small)
+        self.serial = ti.lang.impl.current_cfg().cpu_max_num_threads <= SERIAL_MAX_THREADS
         m = self.m = max(3, round(0.016 * h))
         sh, bh = self.cell(self.small, ss)[1], self.cell(self.big, bs)[1]
         self.th = max(1, h // 360)  # line thickness
@@ -128,12 +136,24 @@ class Hud(runtime.Launcher):
             chars = (w - m - right) // self.cell(self.small, ss)[0]
             rows.append(self.text(fit(" ".join(info.caption.split()), chars), w - m, h - m, DIM, ha="right",
                                   va="bottom"))
-        self.static = np.concatenate(rows) if rows else np.zeros((0, 10), np.int32)
+        self.layer, self.lit = self.bake(rows)
         if self.fan:
             self.spread = runtime.field("hud.spread", runtime.real(), ())
             self.history = runtime.field("hud.history", ti.f32, max(self.frames, 1))
 
     # ------------------------------------------------------------ host-side layout
+    def bake(self, rows: list):
+        """The text that never changes, drawn once (by the font's kernel, in order) into a blank frame, as its
+        lit pixels: y, x, r, g, b, for hud_draw to max into every frame. Returns the field and how many."""
+        img = np.zeros((self.h, self.w, 3), np.uint8)
+        if rows:
+            self.font.draw_glyphs(img, np.concatenate(rows))
+        y, x = np.nonzero(img.any(2))
+        pixels = np.column_stack([y, x, img[y, x]]).astype(np.int32)
+        layer = runtime.field("hud.layer", ti.i32, (max(len(y), 1), 5))  # a field has at least one row
+        layer.from_numpy(pixels if len(y) else np.zeros((1, 5), np.int32))
+        return layer, len(y)
+
     def cell(self, size, scale):
         return text_width("x", scale, size), self.font.text_height("x", scale, size)
 
@@ -182,15 +202,66 @@ class Hud(runtime.Launcher):
     def draw(self, out: np.ndarray, t: float):
         """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
         frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
-        spread = self.launch("hud_graph", out, frame, self.x_of(t))  # returned: no field read, no extra launch
+        spread = self.launch("hud_spread", frame) if self.fan else 0.0  # returned: no field read to launch
         clock = f"t = {t:5.2f} s"
-        rows = [self.static, self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big,
-                                       self.bs, ha="right", va="bottom") if self.info.panel else
-                self.text(clock, self.m, self.m, self.clock_colour(t), self.big, self.bs)]
+        lines = [self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big, self.bs,
+                           ha="right", va="bottom") if self.info.panel else
+                 self.text(clock, self.m, self.m, self.clock_colour(t), self.big, self.bs)]
         if self.fan:
-            label = f"{'spread' if self.words else 'Δ'} {metres(spread)}"
-            rows.append(self.text(label, *self.value_at, CURVE))
-        self.font.draw_glyphs(out, np.concatenate(rows))
+            lines.append(self.text(f"{'spread' if self.words else 'Δ'} {metres(spread)}", *self.value_at, CURVE))
+        self.launch("hud_draw", out, frame, self.x_of(t), np.concatenate(lines), len(lines[0]))
+
+    @ti.kernel
+    def hud_spread(self, frame: ti.i32) -> float:
+        """The spread now (returned) and its history: a max, the same in any order."""
+        self.spread[None] = 0.0
+        ti.loop_config(serialize=True)  # a few thousand pendulums at most: waking threads costs more
+        for i in range(self.n - 1):
+            a, b = self.sim.points(self.sim.q[i]), self.sim.points(self.sim.q[i + 1])
+            d = ti.Vector([b[self.tip, 0] - a[self.tip, 0], b[self.tip, 1] - a[self.tip, 1]]).norm()
+            ti.atomic_max(self.spread[None], d)
+        rel = ti.max(ti.cast(self.spread[None] / self.reach, ti.f32), 1e-30)
+        self.history[frame] = ti.log(rel) / ti.log(10.0)
+        return self.spread[None]
+
+    @ti.kernel
+    def hud_draw(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), frame: ti.i32, now: ti.i32,
+                 glyphs: ti.types.ndarray(dtype=ti.i32, ndim=2), clock: ti.i32):
+        """The static text, the clock (glyphs[:clock]), the spread's value (the other glyphs), the graph and
+        the timeline, into `out`: every write a max, as before.
+
+        Four loops, one after the other, each giving every pixel it writes to one thread: the static text
+        pixel by pixel, each line of text glyph by glyph (a line's cells do not overlap), the graph column
+        by column. So the bytes are the same at any thread count, serial or not."""
+        ti.loop_config(serialize=self.serial)
+        for i in range(self.lit):  # inside the frame: it was drawn there
+            y, x = self.layer[i, 0], self.layer[i, 1]
+            for k in ti.static(range(3)):
+                out[y, x, k] = ti.cast(ti.max(ti.cast(out[y, x, k], ti.i32), self.layer[i, 2 + k]), ti.u8)
+        ti.loop_config(serialize=self.serial)
+        for i in range(clock):
+            self.font.glyph_max(out, glyphs, i)
+        ti.loop_config(serialize=self.serial)
+        for i in range(clock, glyphs.shape[0]):
+            self.font.glyph_max(out, glyphs, i)
+        ti.loop_config(serialize=self.serial)
+        for x in range(self.gx0, self.gx1 + 1):  # column x writes only column x
+            axis = ti.Vector(DIM) if x <= now else ti.Vector(FAINT)
+            for j in range(self.th):
+                self.put(out, self.gy1 + 1 + j, x, axis)
+            for k in ti.static(range(2)):
+                if ti.static(self.ticks[k] >= 0):
+                    if self.ticks[k] <= x < self.ticks[k] + self.th:
+                        self.column(out, x, self.gy0, self.gy1 + 3 * self.th, ti.Vector(self.tick_colours[k]))
+            if ti.static(self.fan):
+                if x <= now:
+                    f = (x - self.gx0) * ti.max(self.frames - 1, 1) // self.gw
+                    f = ti.min(f, frame)
+                    fp = ti.min(ti.max(x - 1 - self.gx0, 0) * ti.max(self.frames - 1, 1) // self.gw, frame)
+                    y, yp = self.y_px(self.history[f]), self.y_px(self.history[fp])
+                    c = self.spread_colour(f)
+                    for j in range(self.th):
+                        self.column(out, x, yp - j, y - j, c)
 
     @ti.func
     def put(self, out: ti.template(), y, x, c):
@@ -214,41 +285,6 @@ class Hud(runtime.Launcher):
                 if t > self.tick_times[k] + 1e-9:
                     c = ti.Vector(self.tick_colours[k])
         return c
-
-    @ti.kernel
-    def hud_graph(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), frame: ti.i32, now: ti.i32) -> float:
-        """The spread now (returned), its history, and the graph and timeline into `out`."""
-        if ti.static(self.fan):
-            self.spread[None] = 0.0
-            ti.loop_config(serialize=True)  # a few thousand pendulums at most: waking threads costs more
-            for i in range(self.n - 1):
-                a, b = self.sim.points(self.sim.q[i]), self.sim.points(self.sim.q[i + 1])
-                d = ti.Vector([b[self.tip, 0] - a[self.tip, 0], b[self.tip, 1] - a[self.tip, 1]]).norm()
-                ti.atomic_max(self.spread[None], d)
-            rel = ti.max(ti.cast(self.spread[None] / self.reach, ti.f32), 1e-30)
-            self.history[frame] = ti.log(rel) / ti.log(10.0)
-        ti.loop_config(serialize=True)  # in order: pixels are read, maxed and written back
-        for x in range(self.gx0, self.gx1 + 1):
-            axis = ti.Vector(DIM) if x <= now else ti.Vector(FAINT)
-            for j in range(self.th):
-                self.put(out, self.gy1 + 1 + j, x, axis)
-            for k in ti.static(range(2)):
-                if ti.static(self.ticks[k] >= 0):
-                    if self.ticks[k] <= x < self.ticks[k] + self.th:
-                        self.column(out, x, self.gy0, self.gy1 + 3 * self.th, ti.Vector(self.tick_colours[k]))
-            if ti.static(self.fan):
-                if x <= now:
-                    f = (x - self.gx0) * ti.max(self.frames - 1, 1) // self.gw
-                    f = ti.min(f, frame)
-                    fp = ti.min(ti.max(x - 1 - self.gx0, 0) * ti.max(self.frames - 1, 1) // self.gw, frame)
-                    y, yp = self.y_px(self.history[f]), self.y_px(self.history[fp])
-                    c = self.spread_colour(f)
-                    for j in range(self.th):
-                        self.column(out, x, yp - j, y - j, c)
-        value = 0.0
-        if ti.static(self.fan):
-            value = self.spread[None]
-        return value
 
     @ti.func
     def y_px(self, v):
