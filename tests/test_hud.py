@@ -103,8 +103,10 @@ def test_a_single_pendulum_has_a_clock_and_a_timeline_but_no_spread():
 SCRIPT = """
 import hashlib, sys
 import numpy as np
-from render import hud, pipeline, runtime
-from render.scene import load
+from render.draw import hud
+from render.video import pipeline
+from render.physics import runtime
+from render.config.scene import load
 threads = int(sys.argv[1])
 for w, h, panel in ((1280, 720, False), (640, 360, True)):
     scene = load("rigid_chaos", [f"video.width={w}", f"video.height={h}", "video.fps=60", "video.duration=0.5"])
