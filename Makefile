@@ -18,11 +18,11 @@ demo: $(BIN)/pendulum
 	$(BIN)/pendulum render rigid_chaos
 
 # Two pytest workers (pytest-xdist): most of a test's time is compiling kernels and starting processes, which
-# are single-threaded, so two workers keep both cores busy. Test files that share the session's preset renders
-# run on one worker (xdist_group).
+# are single-threaded, so two workers keep both cores busy. Each test file runs whole on one worker, the files
+# that share the preset renders together, the costliest first (tests/conftest.py: SHARE_A_WORKER, HEAVY_FIRST).
 JOBS ?= 2
 test: $(BIN)/pendulum
-	$(BIN)/python -m pytest -n $(JOBS) --dist loadgroup --durations=25
+	$(BIN)/python -m pytest -n $(JOBS) --dist loadfile --durations=25
 
 # After a deliberate visual change: rewrite tests/golden/ from the current renderer, then review and commit.
 goldens: $(BIN)/pendulum

@@ -31,6 +31,41 @@ def pytest_sessionfinish(session, exitstatus):
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 
+# `make test` runs two pytest-xdist workers with `--dist loadfile`, which this scheduler refines. Each test
+# module goes to one worker whole, so a module-scoped fixture is built once, not once per worker; the modules
+# in SHARE_A_WORKER go together, because they share a session fixture; and the costliest modules (HEAVY_FIRST,
+# measured) go out first, so that the two workers finish together rather than one waiting on a late long
+# module. (xdist's own `loadgroup` no longer groups anything under pytest 9: it marks a test's group by
+# rewriting item._nodeid, which pytest 9 no longer reads, so both workers rendered every preset.)
+SHARE_A_WORKER = {"test_golden.py": "preset_renders", "test_render.py": "preset_renders"}
+HEAVY_FIRST = ("test_accuracy_cmd.py", "test_golden.py", "test_render.py", "test_bench.py", "test_certify.py",
+               "test_compare.py", "test_fractal.py", "test_integrators.py", "test_step_limit.py", "test_batch.py",
+               "test_hard_cases.py", "test_api.py", "test_hardening.py", "test_fuzz.py", "test_lyapunov.py",
+               "test_ftle.py", "test_poincare.py", "test_glow.py", "test_refusals.py", "test_bad_input.py")
+
+
+@pytest.hookimpl(optionalhook=True)  # an xdist hook: no error where xdist is not loaded
+def pytest_xdist_make_scheduler(config, log):
+    if config.getvalue("dist") != "loadfile":
+        return None  # xdist's own scheduler
+    from xdist.scheduler import LoadFileScheduling
+
+    class ModulesHeavyFirst(LoadFileScheduling):
+        def _split_scope(self, nodeid):
+            path = nodeid.split("::", 1)[0]
+            return SHARE_A_WORKER.get(Path(path).name, path)
+
+    config.option.loadscopereorder = False  # keep the order the workers collected in (heaviest first)
+    return ModulesHeavyFirst(config, log)
+
+
+def pytest_collection_modifyitems(config, items):
+    if not hasattr(config, "workerinput"):
+        return  # not an xdist worker: pytest's own order
+    rank = {name: i for i, name in enumerate(HEAVY_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: each module stays in order
+
+
 def pytest_addoption(parser):
     parser.addoption("--update-goldens", action="store_true",
                      help="rewrite tests/golden/<preset>/*.png from the current renderer instead of comparing")
@@ -68,7 +103,7 @@ def run_cli(*args, cwd=None, timeout=300, **kw):
 
 # Every preset rendered once, small and short, for both the goldens (tests/test_golden.py: raw frames) and the
 # decode-back checks (tests/test_render.py: the MP4, the GIF and metadata.json): compiling each preset's
-# kernels is most of a render's cost here, so one render serves both.
+# kernels is most of a render's cost here, so one render serves both (on one worker: SHARE_A_WORKER).
 SMALL_W, SMALL_H, SMALL_FPS, SMALL_SECONDS = 256, 144, 10, 3.0
 PICKS = {"first": 0, "early": 5, "later": 29}  # t = 0, 0.5 s, 2.9 s: well before f64 round-off matters
 

@@ -13,7 +13,6 @@ import pytest
 from conftest import PICKS, render_small
 from render.config.scene import list_presets
 
-pytestmark = pytest.mark.xdist_group("preset_renders")  # one worker renders the presets for both
 
 GOLDEN = Path(__file__).parent / "golden"
 DIFFS = Path(__file__).resolve().parent.parent / "out" / "golden-diffs"

@@ -10,7 +10,6 @@ from conftest import SMALL_FPS, SMALL_H, SMALL_SECONDS, SMALL_W, out_folder, run
 from render.config.scene import list_presets, load
 from render.physics.system import DEFAULT_MAX_DRIFT
 
-pytestmark = pytest.mark.xdist_group("preset_renders")  # one worker renders the presets for both
 
 PRESETS = [p.stem for p in list_presets()]
 W, H, FPS, SECONDS = SMALL_W, SMALL_H, SMALL_FPS, SMALL_SECONDS  # conftest's preset_renders
