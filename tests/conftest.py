@@ -8,6 +8,14 @@ import pytest
 
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
 os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
+# Taichi's offline cache (on: render/physics/runtime.py): a kernel compiled once loads in a fraction of that
+# time in every later process, this run's and the next run's. The suite keeps its kernels in a folder of its
+# own, big enough for all of them: Taichi's default folder is shared with every Taichi program on the machine
+# and holds 100 MB, least recently used out first, so there the suite's kernels pushed each other out.
+# Inherited by every process the tests start. A compiled kernel is the same code either way: a cache hit
+# cannot change a frame.
+os.environ.setdefault("TI_OFFLINE_CACHE_FILE_PATH", str(Path.home() / ".cache" / "taichi-pendulum-tests"))
+os.environ.setdefault("TI_OFFLINE_CACHE_MAX_SIZE_OF_FILES", str(1 << 30))  # 1 GiB
 
 ROOT = Path(__file__).resolve().parent.parent
 
