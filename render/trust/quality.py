@@ -17,19 +17,14 @@ import sys
 import numpy as np
 
 from . import certify
+from .levels import LEVELS  # noqa: F401 - quality.LEVELS, the levels this module meets
 from ..physics import integrators, registry, runtime
 from ..errors import SceneError
 
-LEVELS = ("draft", "standard", "high", "reference")
 TARGET = {"draft": 0.5, "standard": 0.75, "high": 1.0}  # of the duration, for the median pendulum
 LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)  # steps tried, besides one step per frame
 EVALS = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 6, "implicit_midpoint": 8}  # per step
 PILOT = 16  # pendulums of the fan the pilots run on
-
-
-def check_level(level: str, src: str = "--quality"):
-    if level not in LEVELS:
-        raise SceneError(f"{src}: --quality: unknown level {level!r}; choose from {', '.join(LEVELS)}")
 
 
 def setting(method: str, dt: float, precision: str) -> dict:
