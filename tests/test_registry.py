@@ -138,7 +138,7 @@ def test_every_system_declares_its_contract(name):
     cls = registry.get(name)
     assert cls.SYSTEM == name and cls.NAME and cls.DOC
     assert cls.LINKS and set(cls.LINKS) <= set(LINK_EFFECTS.values())
-    assert cls.D > 0 and cls.METHODS and set(cls.METHODS) <= set(integrators.STABILITY)
+    assert cls.D > 0 and cls.METHODS and set(cls.METHODS) <= set(integrators.METHOD)
     assert set(cls.DEFAULT_EFFECTS) <= set(EFFECTS)
     per_pendulum = {src: 1 for src in ("q", "v")}
     for src, shape in cls.STATE.values():
