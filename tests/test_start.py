@@ -1,5 +1,7 @@
 """A fast start: `pendulum --help`, `pendulum render --help` and a mistyped command import neither Taichi nor scipy
-(a second and more of imports before anything runs); only the module of the command given is imported."""
+(a second and more of imports before anything runs); only the module of the command given is imported. Listing
+the presets and refusing a bad one import no scipy (Taichi still: the loader reads the systems' declarations
+from their Taichi classes)."""
 import re
 import subprocess
 import sys
@@ -27,6 +29,19 @@ def test_the_command_line_starts_without_taichi_or_scipy(args, code):
     assert {"render.commands.cli", "render.config.options", "argparse"} <= modules  # the report is read
     heavy = sorted(m for m in modules if m.split(".")[0] in HEAVY)
     assert not heavy, heavy[:10]
+
+
+def test_presets_and_a_bad_preset_start_without_scipy(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((ROOT / "presets" / "classic.toml").read_text().replace("[pendulums]\n", "[pendulums]\nbogus = 1\n"))
+    for args, code, says in [(["presets"], 0, "classic "), (["render", "nosuch"], 2, "nosuch: no such preset"),
+                             (["render", str(bad), "--out", str(tmp_path / "out")], 2, "pendulums.bogus: unknown key")]:
+        r, modules = importtime(*args)
+        assert r.returncode == code and says in r.stdout + r.stderr, r.stderr[-2000:]
+        assert "render.config.scene" in modules  # the report is read
+        scipy = sorted(m for m in modules if m.split(".")[0] == "scipy")
+        assert not scipy, (args, scipy[:10])
+    assert not (tmp_path / "out").exists()
 
 
 def test_help_lists_every_subcommand():
