@@ -42,6 +42,7 @@ class Method:
     # are linear in their stretch, so this bounds RK2's gain there from the fastest mode
     # (stability.oscillator_limit).
     oscillator_gain: tuple[float, int] | None = None
+    no_tangent: str = ""  # why Taichi's forward mode cannot differentiate it (render/physics/tangent.py), if it cannot
 
 
 METHOD = {
@@ -51,8 +52,11 @@ METHOD = {
                   oscillator_gain=(0.25, 4)),
     "rk4": Method(order=4, stability=2.785, evals=4, color="tab:blue"),
     "yoshida4": Method(order=4, stability=1.573, evals=6, color="tab:green"),  # three Verlet steps of 2
-    "implicit_midpoint": Method(order=2, stability=1.0, evals=8, color="tab:purple"),
+    "implicit_midpoint": Method(order=2, stability=1.0, evals=8, color="tab:purple",
+                                no_tangent="its fixed-point loop stops on a value (break), which Taichi's forward "
+                                           "mode cannot differentiate"),
 }
+
 SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
 AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
 
@@ -116,8 +120,8 @@ def timestep(scene, omega_max: float, energy_limit: float = math.inf) -> tuple[f
         with_damping = f" + damping {damping:g} 1/s" if damping else ""
         raise SceneError(
             f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
-            f"dt*omega_max must stay below {METHOD[method].stability:g} (omega_max = {omega_max:.4g} rad/s{with_damping}, "
-            f"so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
+            f"dt*omega_max must stay below {METHOD[method].stability:g} (omega_max = {omega_max:.4g} "
+            f"rad/s{with_damping}, so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
             f"or set integrator.allow_unstable = true to proceed anyway")
     substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
     return frame_dt / substeps, substeps
