@@ -20,8 +20,9 @@ from ..config.options import add_budget, add_common, add_quality, add_render_opt
 # Subcommands living in their own modules: command -> (module, the line `pendulum --help` lists it with). Each
 # module has add_parser(subparsers) and run(args) -> exit code. Only the module of the command given is imported:
 # most of them import Taichi or scipy (a second and more before anything runs), which `pendulum --help` and a
-# mistyped command have no use for. So this module and what it imports at the top stay light; the heavy imports
-# are inside the functions that use them. tests/test_start.py keeps both, and these lines the modules' own.
+# mistyped command have no use for. So this module and what it imports at the top stay light, and the heavy
+# imports are inside the functions that use them. tests/test_start.py checks that --help imports neither, and
+# that each line here is the one its module gives.
 COMMANDS = {
     "accuracy": ("accuracy", "measure error vs. time of every integrator; charts and tables"),
     "batch": ("batch", "render many presets (default: all) in parallel, locally or on Dask"),
