@@ -138,5 +138,5 @@ def preset_renders(tmp_path_factory):
     out = tmp_path_factory.mktemp("presets")
     with pytest.MonkeyPatch.context() as mp:
         # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.
-        mp.setattr(split, "cost", lambda run: 1e-3 * split.integrators.ORDER[run["integrator"]["method"]])
+        mp.setattr(split, "cost", lambda run: 1e-3 * split.integrators.METHOD[run["integrator"]["method"]].order)
         return {p.stem: render_small(p.stem, out) for p in list_presets()}

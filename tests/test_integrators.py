@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from render.commands import accuracy
-from render.physics import reference, runtime
+from render.physics import integrators, reference, runtime
 from render.video.pipeline import make_system
 from render.config.scene import METHODS
 
@@ -26,6 +26,17 @@ def refs():
         sc = accuracy.case_scene(system, "rk4", "f64", 1e-3, horizon)
         out[system] = reference.solve(sc, reference.initial_state(sc), horizon)
     return out
+
+
+def test_the_method_table_states_what_the_methods_are():
+    """One row per method (integrators.METHOD): its order the theoretical one the convergence tests check against
+    DOP853, a distinct chart colour each, and an oscillator gain for each method that gains energy on springs
+    (stability.oscillator_limit reads it there)."""
+    table = integrators.METHOD
+    assert {m: row.order for m, row in table.items()} == THEORY
+    assert len({row.color for row in table.values()}) == len(table)
+    assert all(row.stability > 0 and row.evals >= 1 for row in table.values())
+    assert all((row.oscillator_gain is not None) == ("springs" in row.energy_gain) for row in table.values())
 
 
 def traj_error(system, method, precision, dt, ref):

@@ -8,10 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..physics.integrators import METHOD
 from ..video.atomic import write_atomic
 
-COLORS = {"symplectic_euler": "tab:red", "verlet": "tab:orange", "implicit_midpoint": "tab:purple",
-          "rk2": "tab:cyan", "rk4": "tab:blue", "yoshida4": "tab:green"}
 STYLE = {"f64": "-", "f32": "--"}
 COST = "cost: wall time per pendulum per simulated second [µs]  (= ns per step / dt)"
 
@@ -42,10 +41,10 @@ def lines_by_method(ax, rows, x, y, plot="loglog", ring=None):
                    and math.isfinite(y(r))]
             if pts:
                 xs, ys, dts = map(np.array, zip(*pts))
-                getattr(ax, plot)(xs, ys, STYLE[p], marker="o", ms=4, color=COLORS[m], label=f"{m} {p}")
+                getattr(ax, plot)(xs, ys, STYLE[p], marker="o", ms=4, color=METHOD[m].color, label=f"{m} {p}")
                 if ring is not None:
                     at = dts == ring
-                    getattr(ax, plot)(xs[at], ys[at], "o", ms=10, mfc="none", color=COLORS[m])
+                    getattr(ax, plot)(xs[at], ys[at], "o", ms=10, mfc="none", color=METHOD[m].color)
 
 
 def accuracy_charts(out: Path, rows, energy, chaos, cases, units, fps, long_dt, chaos_fps):
@@ -66,7 +65,7 @@ def accuracy_charts(out: Path, rows, energy, chaos, cases, units, fps, long_dt, 
         for (s2, m, p), series in energy.items():
             if s2 == s:  # running max: a bounded error stays flat, a drift keeps climbing
                 ax.semilogy(np.arange(1, len(series)) / fps, np.maximum.accumulate(np.abs(series[1:]).max(1)),
-                            STYLE[p], color=COLORS[m], label=f"{m} {p}")
+                            STYLE[p], color=METHOD[m].color, label=f"{m} {p}")
                 steps = round((len(series) - 1) / fps / long_dt)
         save(fig, ax, out / f"energy_drift_{s}.png", "simulated time [s]",
              "relative energy error so far, max |E − E0| / |E0| [1]",

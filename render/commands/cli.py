@@ -7,18 +7,31 @@ PENDULUM_DEBUG=1 prints the traceback as well.
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import signal
 import sys
 import traceback
 from pathlib import Path
 
-from . import accuracy, batch, bench, comparison, gallery, lyapunov_cli, show
 from ..errors import BatchError, EncodeError, SceneError, SimulationError
 from ..config.options import add_budget, add_common, add_quality, add_render_options, budgeted, output_name, progress_wanted
 
-# Subcommands living in their own modules; each has add_parser(subparsers) and run(args) -> exit code.
-MODULES = (accuracy, batch, bench, comparison, gallery, lyapunov_cli, show)
+# Subcommands living in their own modules: command -> (module, the line `pendulum --help` lists it with). Each
+# module has add_parser(subparsers) and run(args) -> exit code. Only the module of the command given is imported:
+# most of them import Taichi or scipy (a second and more before anything runs), which `pendulum --help` and a
+# mistyped command have no use for. So this module and what it imports at the top stay light, and the heavy
+# imports are inside the functions that use them. tests/test_start.py checks that --help imports neither, and
+# that each line here is the one its module gives.
+COMMANDS = {
+    "accuracy": ("accuracy", "measure error vs. time of every integrator; charts and tables"),
+    "batch": ("batch", "render many presets (default: all) in parallel, locally or on Dask"),
+    "bench": ("bench", "performance report: simulate, draw, encode, end to end, fractal"),
+    "compare": ("comparison", "one split-screen video of 2 to 4 variants of a preset (OUT/compare/NAME/)"),
+    "gallery": ("gallery", "write OUT/index.html: every render in OUT with its video and certificate"),
+    "lyapunov": ("lyapunov_cli", "the Lyapunov spectrum of chosen pendulums (OUT/NAME/lyapunov.json)"),
+    "show": ("show", "play a preset live in a window (space, →, r, s, q)"),
+}
 
 
 class Terminated(BaseException):
@@ -30,7 +43,8 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {one_line(message)} (see --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv=()) -> argparse.ArgumentParser:
+    """The parser for the command line `argv`: complete for the command it gives, the others only listed."""
     p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
                epilog="Presets live in presets/*.toml; see docs/presets.md for the format.")
     p.add_argument("--debug", action="store_true", help="on an error, print the traceback too "
@@ -61,8 +75,12 @@ def build_parser() -> argparse.ArgumentParser:
     ls = sub.add_parser("presets", help="list the presets, one line each")
     ls.set_defaults(func=cmd_presets)
 
-    for module in MODULES:
-        module.add_parser(sub)
+    given = next((a for a in argv if not a.startswith("-")), None)  # before it come only flags (--debug, -h)
+    for command, (module, line) in COMMANDS.items():
+        if command == given:
+            importlib.import_module(f"{__package__}.{module}").add_parser(sub)
+        else:
+            sub.add_parser(command, help=line)
     for command in sub.choices.values():  # --debug also after the command; main() reads it from argv
         command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     return p
@@ -133,7 +151,7 @@ def main(argv=None) -> int:
     # read before parsing, so that even an error while parsing can show its traceback
     debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser(argv).parse_args(argv)
         return args.func(args)
     except SceneError as e:
         return fail(2, "error", e, debug)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from ..trust import certify, quality
 from ..physics import grid, registry
+from ..physics.integrators import METHOD
 from ..physics.keys import DRAWN
 
 RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
@@ -33,7 +34,7 @@ RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
 # 720p frame to draw with the HUD and 17 ms to encode as MP4 and GIF), so these err long.
 RATES = {
     # RK4 pendulum-steps per second of the advance kernel at N = 1e4 (measured 2.5e7, 3.7e7, 7.6e7, 1.5e8,
-    # 1.4e7, 2.1e7); other methods in proportion to their force evaluations per step (quality.EVALS).
+    # 1.4e7, 2.1e7); other methods in proportion to their force evaluations per step (integrators.Method.evals).
     "steps_per_s": {"rigid_f64": 2.5e7, "rigid_f32": 3.5e7, "elastic_f64": 7.0e7, "elastic_f32": 1.4e8,
                     "triple_f64": 1.4e7, "triple_f32": 2.0e7},
     "frame_s": 3e-4,  # per simulated frame: a launch of 1 substep of 128 pendulums took 150-300 µs
@@ -155,7 +156,7 @@ def steps_per_s(rates: dict, system: str, precision: str, method: str) -> float:
     """Pendulum-steps per second of `method`: RK4's rate over the ratio of their force evaluations. A system
     with no rate of its own takes the slowest known."""
     table = rates["steps_per_s"]
-    return table.get(f"{system}_{precision}", min(table.values())) * quality.EVALS["rk4"] / quality.EVALS[method]
+    return table.get(f"{system}_{precision}", min(table.values())) * METHOD["rk4"].evals / METHOD[method].evals
 
 
 def run_s(scene, rates: dict, method: str, precision: str, substeps: int, n: int, frames: int | None = None) -> float:

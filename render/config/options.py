@@ -20,8 +20,7 @@ except ImportError:  # not POSIX
 
 from ..errors import SceneError
 from ..physics.keys import BUDGET_MAX, BUDGET_MIN, seconds
-from ..trust.quality import LEVELS
-from .validate import NAME_MAX, NAME_PATTERN, clip
+from ..trust.levels import LEVELS
 
 ARCHES = ("cpu", "cuda")  # runtime.init's backends (never ti.gpu)
 
@@ -84,6 +83,8 @@ def add_name(p):
 
 def folder_name(text: str) -> str:
     """An argparse type: a name a scene may have (validate.py), so it is safe as a folder and file name."""
+    from .validate import NAME_MAX, NAME_PATTERN
+
     if not re.fullmatch(NAME_PATTERN, text) or len(text) > NAME_MAX:
         raise argparse.ArgumentTypeError(f"must be letters, digits, _ . - (not first . or -), at most {NAME_MAX} "
                                          f"characters, got {text[:40]!r}")
@@ -97,6 +98,8 @@ def output_name(scene, overridden: bool, name: str | None = None):
     """The scene under the name of the folder it renders to. OUT/NAME/ is only ever the preset as written:
     with overrides (--set, --quality) the folder is NAME__<short hash of the resolved scene>, the same for
     the same result however the overrides were spelled, unless --name gives it a name."""
+    from .validate import NAME_MAX
+
     if name is not None:
         if overridden and name == scene.name:
             raise SceneError(f"--name {name}: is the folder of the preset as written; name the render with "
@@ -123,6 +126,8 @@ def thread_count(text: str) -> int:
 
 def check_arch(arch) -> str:
     """The API's arch=: what --arch accepts (SceneError otherwise)."""
+    from .validate import clip
+
     if not isinstance(arch, str) or arch not in ARCHES:
         raise SceneError(f"arch={clip(repr(arch))}: must be one of {', '.join(ARCHES)}")
     return arch
@@ -130,6 +135,8 @@ def check_arch(arch) -> str:
 
 def check_threads(threads) -> int | None:
     """The API's threads=: None (all cores) or what --threads accepts (SceneError otherwise)."""
+    from .validate import clip
+
     if threads is None:
         return None
     if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):

@@ -15,7 +15,7 @@ from pathlib import Path
 from ..physics import keys, registry
 from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from ..errors import SceneError
-from ..trust.quality import check_level
+from ..trust.levels import check_level
 from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
                        MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
 

@@ -16,7 +16,7 @@ import re
 
 from ..physics import grid, keys, registry
 from ..errors import SceneError
-from ..trust.quality import LEVELS
+from ..trust.levels import LEVELS
 from .vary import PANEL_MIN, VARIANTS, VARYING, Twice, dotted, frozen, plain, vary_refusal
 
 SYSTEMS = registry.names()

@@ -122,7 +122,7 @@ def finest(runs: list[dict]) -> int:
     def rank(i):
         c, integ = runs[i]["cert"], runs[i]["integrator"]
         return (c.median_until_s, c.faithful_until_s, c.fraction_faithful, integ["precision"] == "f64",
-                integrators.ORDER[integ["method"]], -integ["dt"], -i)
+                integrators.METHOD[integ["method"]].order, -integ["dt"], -i)
     return max(range(len(runs)), key=rank)
 
 

@@ -1,10 +1,12 @@
-"""The integration methods, each written once, and the step size that keeps them stable.
+"""The integration methods, each written once, their facts in one table (METHOD), and the step size that keeps
+them stable.
 
 A method works on any system: it needs only the system's `force(q, v)` (and, for the implicit midpoint, its
 canonical hooks `momenta`, `velocities`, `momentum_rate` and `p_scale`). States are "lane matrices": row k is
 coordinate k, column l is pendulum l of a group (see System.advance), so a method is plain matrix arithmetic.
 The method is chosen at compile time with ti.static, so a run compiles only the one it uses.
 """
+import dataclasses
 import math
 
 import taichi as ti
@@ -13,27 +15,48 @@ from ..errors import SceneError
 
 DEFAULT_MAX_DRIFT = 0.05  # the energy watchdog's tolerance unless a scene sets integrator.max_drift
 
-# dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
-# implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
-# rk2's 2 is its limit on the real axis (a decaying mode: |1 + z + z²/2| <= 1 for z in [-2, 0]). On the
-# imaginary axis no explicit two-stage method is stable at any step: an undamped oscillation grows by
-# |1 + iy - y²/2| = sqrt(1 + y⁴/4), about 1 + y⁴/8 per step for y = h·ω, i.e. 2e-4 per step at "auto"'s
-# y = 0.2 on the fastest mode the bound allows, 2e-7 on rigid_chaos at dt = 1e-3 (y = 0.034). The energy
-# watchdog stops a run where that growth shows.
-STABILITY = {"symplectic_euler": 2.0, "verlet": 2.0, "rk2": 2.0, "rk4": 2.785, "yoshida4": 1.573,
-             "implicit_midpoint": 1.0}
-ORDER = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 4, "implicit_midpoint": 2}
-# Where a method gains energy run-long, by the coordinates the system steps (its reference model): symplectic
-# Euler is symplectic on Cartesian springs (constant masses: v is a momentum up to them), not on a chain's
-# (θ, ω), whose mass matrix depends on θ; RK2 gains on every oscillation (|R(iy)|² = 1 + y⁴/4). There the step
-# must also keep the gain within max_drift over the run (render/physics/stability.py's energy_limit). The others keep
-# energy bounded (Verlet and Yoshida on springs, the implicit midpoint stepping canonical (q, p) everywhere),
-# or only lose it at a stable step (RK4: |R(iy)| < 1 for y < 2.83), which leaves the stability bound's
-# premise, E ≤ E_max·(1 + max_drift), intact; the watchdog still stops a loss beyond max_drift.
-ENERGY_GAIN = {"symplectic_euler": ("chain",), "rk2": ("chain", "springs")}
-# On a linear oscillator a method that gains energy gains c·y^k of it per step (y = h·ω): (c, k). Springs are
-# linear in their stretch, so this bounds RK2's gain there from the fastest mode (stability.oscillator_limit).
-OSCILLATOR_GAIN = {"rk2": (0.25, 4)}
+
+@dataclasses.dataclass(frozen=True)
+class Method:
+    """What the rest of the program knows of a method besides its code: one row of METHOD."""
+    order: int  # of its global error: the certificate picks its shadow by it, a comparison its finest variant
+    # dt·ω_max must stay below this for the method to be stable on a linear oscillator (ω the fastest mode).
+    # implicit_midpoint's bound is where its fixed-point iteration stops contracting (h·L < 1), not stability.
+    # rk2's 2 is its limit on the real axis (a decaying mode: |1 + z + z²/2| <= 1 for z in [-2, 0]). On the
+    # imaginary axis no explicit two-stage method is stable at any step: an undamped oscillation grows by
+    # |1 + iy - y²/2| = sqrt(1 + y⁴/4), about 1 + y⁴/8 per step for y = h·ω, i.e. 2e-4 per step at "auto"'s
+    # y = 0.2 on the fastest mode the bound allows, 2e-7 on rigid_chaos at dt = 1e-3 (y = 0.034). The energy
+    # watchdog stops a run where that growth shows.
+    stability: float
+    evals: int  # force evaluations per step: the cost --quality ranks candidates by, and the run-time estimate
+    color: str  # its line in the charts of `pendulum accuracy` (a matplotlib colour)
+    # Where it gains energy run-long, by the coordinates the system steps (its reference model): symplectic
+    # Euler is symplectic on Cartesian springs (constant masses: v is a momentum up to them), not on a chain's
+    # (θ, ω), whose mass matrix depends on θ; RK2 gains on every oscillation (|R(iy)|² = 1 + y⁴/4). There the
+    # step must also keep the gain within max_drift over the run (render/physics/stability.py's energy_limit).
+    # The others keep energy bounded (Verlet and Yoshida on springs, the implicit midpoint stepping canonical
+    # (q, p) everywhere), or only lose it at a stable step (RK4: |R(iy)| < 1 for y < 2.83), which leaves the
+    # stability bound's premise, E ≤ E_max·(1 + max_drift), intact; the watchdog still stops a loss beyond it.
+    energy_gain: tuple[str, ...] = ()
+    # On a linear oscillator a method that gains energy gains c·y^k of it per step (y = h·ω): (c, k). Springs
+    # are linear in their stretch, so this bounds RK2's gain there from the fastest mode
+    # (stability.oscillator_limit).
+    oscillator_gain: tuple[float, int] | None = None
+    no_tangent: str = ""  # why Taichi's forward mode cannot differentiate it (render/physics/tangent.py), if it cannot
+
+
+METHOD = {
+    "symplectic_euler": Method(order=1, stability=2.0, evals=1, color="tab:red", energy_gain=("chain",)),
+    "verlet": Method(order=2, stability=2.0, evals=2, color="tab:orange"),
+    "rk2": Method(order=2, stability=2.0, evals=2, color="tab:cyan", energy_gain=("chain", "springs"),
+                  oscillator_gain=(0.25, 4)),
+    "rk4": Method(order=4, stability=2.785, evals=4, color="tab:blue"),
+    "yoshida4": Method(order=4, stability=1.573, evals=6, color="tab:green"),  # three Verlet steps of 2
+    "implicit_midpoint": Method(order=2, stability=1.0, evals=8, color="tab:purple",
+                                no_tangent="its fixed-point loop stops on a value (break), which Taichi's forward "
+                                           "mode cannot differentiate"),
+}
+
 SAFETY = 0.1  # "auto" keeps dt·ω_max at a tenth of the limit: stable is not enough, it must be accurate
 AUTO_DT = 1e-3  # longest step "auto" takes when no stiffness limits it
 
@@ -45,7 +68,7 @@ YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
 
 def gains_energy(method: str, model: str) -> bool:
     """Whether `method` gains energy run-long on a system of this reference model ("chain" | "springs")."""
-    return model in ENERGY_GAIN.get(method, ())
+    return model in METHOD[method].energy_gain
 
 
 def step_limit(scene, omega_max: float, energy_limit: float = math.inf) -> float:
@@ -63,7 +86,7 @@ def stability_limit(scene, omega_max: float) -> float:
     if not math.isfinite(rate):
         raise SceneError(f"{scene.source}: pendulums: the scene's fastest rate is not finite (omega_max = "
                          f"{omega_max}): its values are beyond what f64 arithmetic can step")
-    return STABILITY[scene.integrator.method] / rate if rate > 0 else math.inf  # at rest without gravity
+    return METHOD[scene.integrator.method].stability / rate if rate > 0 else math.inf  # at rest without gravity
 
 
 SUBSTEP_LIMIT = 2 ** 31 - 1  # System.advance takes the substeps per frame as a Taichi i32
@@ -97,8 +120,8 @@ def timestep(scene, omega_max: float, energy_limit: float = math.inf) -> tuple[f
         with_damping = f" + damping {damping:g} 1/s" if damping else ""
         raise SceneError(
             f"{scene.source}: integrator.dt: {dt:g} s is beyond the stability limit of {method} for this scene: "
-            f"dt*omega_max must stay below {STABILITY[method]:g} (omega_max = {omega_max:.4g} rad/s{with_damping}, "
-            f"so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
+            f"dt*omega_max must stay below {METHOD[method].stability:g} (omega_max = {omega_max:.4g} "
+            f"rad/s{with_damping}, so dt < {limit:.3g} s); use integrator.dt = \"auto\" or a smaller dt, "
             f"or set integrator.allow_unstable = true to proceed anyway")
     substeps = max(1, math.ceil(frame_dt / dt - 1e-9))
     return frame_dt / substeps, substeps

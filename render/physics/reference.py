@@ -14,7 +14,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 RTOL = 1e-13  # DOP853 stays well-behaved down to ~100 ulps; tighter only adds round-off
 
@@ -194,6 +193,9 @@ def solve(src, y0, t_end: float, t_eval=None, rtol: float = RTOL, atol: float = 
     def rhs(t, y):
         q, v = y[:n * d].reshape(n, d), y[n * d:].reshape(n, d)
         return np.concatenate([v.ravel(), f(q, v, p).ravel()])
+
+    from scipy.integrate import solve_ivp  # not at the top: loading any scene loads this module (stability.py
+    # bounds the step with its models), and scipy takes about a second to import
 
     sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([q0.ravel(), v0.ravel()]), method="DOP853",
                     rtol=rtol, atol=atol, t_eval=[t_end] if t_eval is None else t_eval)

@@ -10,9 +10,9 @@ everywhere (random, plus every aligned and folded configuration), and velocities
 random directions and along M(θ)'s eigenvectors (the soft mode is the "whip" of a heavy lower bob). The
 Jacobian is taken by central differences of render/physics/reference.py's independent model; the largest radius
 found, times MARGIN for the gaps between samples, is the bound. A step h is stable for a method when h·bound
-stays below the method's limit (integrators.STABILITY).
+stays below the method's limit (integrators.Method.stability).
 
-Stable is not enough where the method is not symplectic on (θ, ω) (integrators.ENERGY_GAIN: symplectic Euler
+Stable is not enough where the method is not symplectic on (θ, ω) (integrators.Method.energy_gain: symplectic Euler
 and RK2; the mass matrix depends on θ): energy then grows run-long, and near the stability limit chains
 drifted by 2-400 % in 5 s or blew up, which voids the premise above. energy_limit measures that growth:
 the method itself runs PILOT_STEPS steps of auto's step (a tenth of the stability limit) on the reference
@@ -138,7 +138,7 @@ def _energy_limit(scene, q0, v0, method, floor) -> float:
     rate = MARGIN * float(radii.max()) + damping
     if rate <= 0:
         return math.inf  # at rest without gravity: nothing moves
-    h = integrators.SAFETY * integrators.STABILITY[method] / rate  # auto's step
+    h = integrators.SAFETY * integrators.METHOD[method].stability / rate  # auto's step
     rng = np.random.default_rng(1)
     pick = np.concatenate([np.argsort(radii)[-PILOT_STATES:], rng.choice(len(radii), PILOT_STATES)])
     starts = np.unique(np.round(np.linspace(0, len(q0) - 1, min(len(q0), PILOT_STARTS))).astype(np.int64))
@@ -149,7 +149,7 @@ def _energy_limit(scene, q0, v0, method, floor) -> float:
     while not math.isfinite(predicted):  # blew up even at a tenth of the stability limit: pilot finer
         h /= 4
         predicted = pilot(p, q, v, scale, h, method, scene.video.duration)
-    return h * min(1.0, allowed / predicted) ** (1.0 / integrators.ORDER[method]) if predicted > 0 else h
+    return h * min(1.0, allowed / predicted) ** (1.0 / integrators.METHOD[method].order) if predicted > 0 else h
 
 
 def pilot(p, q: np.ndarray, v: np.ndarray, scale: np.ndarray, h: float, method: str, duration: float) -> float:
@@ -171,10 +171,10 @@ def pilot(p, q: np.ndarray, v: np.ndarray, scale: np.ndarray, h: float, method: 
 
 def oscillator_limit(scene, omega_max: float, method: str) -> float:
     """The energy limit on linear springs, where a method gains c·y^k of a mode's energy per step
-    (integrators.OSCILLATOR_GAIN), most on the fastest mode: all the energy there, the T/h steps of the run
+    (integrators.Method.oscillator_gain), most on the fastest mode: all the energy there, the T/h steps of the run
     gain T·c·h^(k−1)·ω^k, at most max_drift / DRIFT_MARGIN; inf where the method does not gain on springs."""
     if not integrators.gains_energy(method, "springs") or omega_max <= 0:
         return math.inf
-    c, k = integrators.OSCILLATOR_GAIN[method]
+    c, k = integrators.METHOD[method].oscillator_gain
     allowed = (scene.integrator.max_drift or DEFAULT_MAX_DRIFT) / DRIFT_MARGIN
     return (allowed / (c * scene.video.duration * omega_max ** k)) ** (1.0 / (k - 1))

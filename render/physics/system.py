@@ -122,7 +122,7 @@ class System(runtime.Launcher):
 
     def energy_limit(self, q0: np.ndarray, v0: np.ndarray, method: str) -> float:
         """The longest step (s) at which `method` keeps the energy gain of the whole run from these initial
-        states within integrator.max_drift, where it gains energy on this system (integrators.ENERGY_GAIN);
+        states within integrator.max_drift, where it gains energy on this system (integrators.Method.energy_gain);
         inf where it does not."""
         return math.inf
 

@@ -37,17 +37,15 @@ import taichi as ti
 from . import integrators, registry
 from ..errors import SceneError
 
-UNSUPPORTED = {"implicit_midpoint": "its fixed-point loop stops on a value (break), which Taichi's forward mode "
-                                    "cannot differentiate"}
-
 
 def check_method(scene):
     """Refuse (bad input) a scene whose integrator the tangent kernel cannot differentiate."""
     method = scene.integrator.method
-    if method in UNSUPPORTED:
-        raise SceneError(f"{scene.source}: integrator.method: {method}: no tangent map: {UNSUPPORTED[method]}; "
-                         f"use --set integrator.method=rk4 (or another of "
-                         f"{', '.join(m for m in registry.get(scene.system).METHODS if m not in UNSUPPORTED)})")
+    why = integrators.METHOD[method].no_tangent
+    if why:
+        others = [m for m in registry.get(scene.system).METHODS if not integrators.METHOD[m].no_tangent]
+        raise SceneError(f"{scene.source}: integrator.method: {method}: no tangent map: {why}; "
+                         f"use --set integrator.method=rk4 (or another of {', '.join(others)})")
 
 
 def libm_twin(sim):

@@ -96,7 +96,7 @@ MARGIN = 1.1  # the shadow's own error is below a tenth of the main run's: e ≤
 def shadow_scene(scene, h: float):
     """The shadow's settings, in f64: RK4 at the main step, or an order-4 main method at a quarter of it."""
     method = scene.integrator.method
-    high = integrators.ORDER[method] >= 4
+    high = integrators.METHOD[method].order >= 4
     if not high and "rk4" in registry.get(scene.system).METHODS:
         method = "rk4"
     return scene.replace(integrator={"method": method, "dt": h / 4 if high else h, "precision": "f64",

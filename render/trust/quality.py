@@ -17,19 +17,13 @@ import sys
 import numpy as np
 
 from . import certify
+from .levels import LEVELS  # noqa: F401 - quality.LEVELS, the levels this module meets
 from ..physics import integrators, registry, runtime
 from ..errors import SceneError
 
-LEVELS = ("draft", "standard", "high", "reference")
 TARGET = {"draft": 0.5, "standard": 0.75, "high": 1.0}  # of the duration, for the median pendulum
 LADDER = (1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)  # steps tried, besides one step per frame
-EVALS = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "rk4": 4, "yoshida4": 6, "implicit_midpoint": 8}  # per step
 PILOT = 16  # pendulums of the fan the pilots run on
-
-
-def check_level(level: str, src: str = "--quality"):
-    if level not in LEVELS:
-        raise SceneError(f"{src}: --quality: unknown level {level!r}; choose from {', '.join(LEVELS)}")
 
 
 def setting(method: str, dt: float, precision: str) -> dict:
@@ -39,7 +33,7 @@ def setting(method: str, dt: float, precision: str) -> dict:
 def cost(s: dict, fps: int) -> float:
     """Force evaluations per simulated second, f32 at half weight."""
     steps = math.ceil(1.0 / (fps * s["dt"]) - 1e-9) * fps
-    return EVALS[s["method"]] * steps * (0.5 if s["precision"] == "f32" else 1.0)
+    return integrators.METHOD[s["method"]].evals * steps * (0.5 if s["precision"] == "f32" else 1.0)
 
 
 def offered(scene, plan) -> list[dict]:
@@ -72,7 +66,7 @@ def choose(scene, arch: str = "cpu", threads=None):
         raise SceneError(f"{scene.source}: --quality {level}: no integrator is stable for this scene at the steps "
                          f"tried ({', '.join(f'{d:g}' for d in LADDER)} s)")
     if level == "reference":
-        best = min(cands, key=lambda s: (s["precision"] != "f64", s["dt"], -integrators.ORDER[s["method"]]))
+        best = min(cands, key=lambda s: (s["precision"] != "f64", s["dt"], -integrators.METHOD[s["method"]].order))
         return _with(scene, best), {"level": level, "chosen": best, "why": "the finest step in f64, whatever it costs"}
     duration = scene.video.duration
     need = TARGET[level] * duration
