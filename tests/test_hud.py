@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 
 from render.draw import hud
-from render.video import pipeline
-from render.physics import runtime
+from render.physics.stepper import Run
 from render.config.scene import load
 
 W, H, FPS = 256, 144, 10
@@ -15,13 +14,13 @@ def run(name, info=None, upto=None, sets=()):
     """Draw a preset's frames with the HUD on (small, short); returns the canvas, the frames and the system."""
     scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", "video.duration=0.5",
                         'effects=["bobs", "hud"]', *sets])
-    runtime.init("cpu", scene.integrator.precision)
     from render.draw.canvas import Canvas
 
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     canvas = Canvas(scene, sim, info)
     frames = []
-    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for f in run.frames():
         frames.append(canvas.draw(t=f / FPS).copy())
         if f == upto:
             break
