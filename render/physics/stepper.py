@@ -20,11 +20,16 @@ from .system import DEFAULT_MAX_DRIFT
 
 
 class Run:
-    """One system of `scene` (only the pendulums at `subset`, if given) in a Taichi runtime started for it."""
+    """One system of `scene` (only the pendulums at `subset`, if given) in a Taichi runtime started for it.
 
-    def __init__(self, scene, arch: str = "cpu", threads: int | None = None, subset=None):
+    precision: the runtime's, where it is not the scene's (a comparison draws every panel from f64 states).
+    keep_log: add this run's kernels and fields to those logged so far (runtime.launched, .allocated: what
+    metadata reports), as one drawing pass of several systems does, instead of starting the log afresh."""
+
+    def __init__(self, scene, arch: str = "cpu", threads: int | None = None, subset=None,
+                 precision: str | None = None, keep_log: bool = False):
         self.scene = scene
-        self.arch = runtime.init(arch, scene.integrator.precision, threads)  # the arch actually in use
+        self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log)  # the one in use
         self.generation = runtime.generation()
         self.sim = registry.get(scene.system)(scene, subset)
 
