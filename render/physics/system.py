@@ -301,7 +301,7 @@ class System(runtime.Launcher):
         """Energy scale for pendulums whose own energy is near zero."""
         return 1e-3 * sum(self.masses) * max(self.g, 1.0) * sum(self.lengths)
 
-    # --------------------------------------------------------------- host side (the frame loop: render/physics/stepper.py)
+    # --------------------------------------------------------------- host side (for render/physics/stepper.py)
     def measure_energy(self, first: bool = False):
         """Energies at this frame into self.e, and the max relative drift so far into self.drift."""
         if first:
