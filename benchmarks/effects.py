@@ -23,8 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from render.video import pipeline
-from render.physics import runtime  # noqa: E402
+from render.physics.stepper import Run  # noqa: E402
 from render.draw.canvas import Canvas  # noqa: E402
 from render.config.scene import load  # noqa: E402
 
@@ -48,13 +47,13 @@ def measure(preset: str, effects: list[str], frames: int, cpu: bool = False) -> 
     if "damping" in effects:
         sets.append("pendulums.damping=0.1")
     scene = load(preset, sets)
-    runtime.init("cpu", scene.integrator.precision, 1 if cpu else None)
+    run = Run(scene, "cpu", 1 if cpu else None)
     clock = time.process_time if cpu else time.perf_counter
-    sim = pipeline.make_system(scene)
+    sim = run.sim
     drawn = any(e in scene.effects for e in ("bobs", "rods", "springs", "trails"))
     canvas = Canvas(scene, sim) if drawn else None
     sim_ms, draw_ms = [], []
-    steps = pipeline.frames(scene, sim, {"simulate": 0.0})
+    steps = run.frames(timings={"simulate": 0.0})
     while True:
         t = clock()
         f = next(steps, None)  # simulates the frame (and its energy and watchdog)

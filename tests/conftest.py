@@ -1,4 +1,4 @@
-"""Shared fixtures. Taichi has one runtime per process; tests call runtime.init with what they need."""
+"""Shared fixtures. Taichi has one runtime per process; a Run (render/physics/stepper.py) starts the one it needs."""
 import os
 import subprocess
 import sys

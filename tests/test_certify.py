@@ -8,7 +8,8 @@ import pytest
 from conftest import make_scene, out_folder, run_cli
 from render.trust import certify, quality
 from render.video import pipeline
-from render.physics import reference, runtime
+from render.physics import reference, registry
+from render.physics.stepper import Run
 from render.config.scene import load
 
 
@@ -110,7 +111,7 @@ def test_the_step_limit_refuses_up_front_what_would_blow_up(tmp_path, case):
 
 def limit_of(scene) -> float:
     from render.physics.integrators import step_limit
-    plan = pipeline.registry.get(scene.system)(scene, allocate=False)
+    plan = registry.get(scene.system)(scene, allocate=False)
     q0, v0 = plan.initial_state()
     return step_limit(scene, plan.omega_max(q0, v0), plan.energy_limit(q0, v0, scene.integrator.method))
 
@@ -128,9 +129,9 @@ def test_a_step_just_inside_the_limit_runs_clean(system, method, pend):
     base = make_scene(system, 8, pendulums={**pend, "spread": 0.3}, video={"fps": 10, "duration": 10.0},
                       integrator={"method": method, "min_faithful": 0.0, "max_drift": 1.0}, effects=["energy"])
     scene = base.replace(integrator={"dt": 0.95 * limit_of(base)})  # the energy watchdog guards the bound's premise
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):  # the NaN watchdog raises on a blow-up
+    run = Run(scene)
+    sim = run.sim
+    for _ in run.frames():  # the NaN watchdog raises on a blow-up
         pass
     assert np.isfinite(sim.q.to_numpy()).all() and sim.drift[None] < 1.0
 

@@ -5,6 +5,7 @@ import pytest
 from conftest import make_scene
 from render.video import pipeline
 from render.physics import runtime
+from render.physics.stepper import Run
 
 VIDEO = {"width": 160, "height": 90, "fps": 10, "duration": 0.5}
 PEND = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
@@ -73,10 +74,10 @@ def test_damping_is_simulated_only_when_called_for(tmp_path):
     free, _ = render(tmp_path, effects=("rods", "energy"))
     assert "damping" not in free["effects"] and free["energy"]["max_rel_drift"] < 1e-9
 
-    runtime.init("cpu", "f64")
     scene = make_scene("rigid", 4, effects=["energy"], pendulums={**PEND, "damping": 0.5}, video=VIDEO)
-    sim = pipeline.make_system(scene)
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    run = Run(scene)
+    sim = run.sim
+    for _ in run.frames():
         pass
     assert (sim.e.to_numpy() < sim.e0.to_numpy()).all()
 

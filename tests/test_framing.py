@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from render.video import pipeline
-from render.physics import registry, runtime
+from render.physics import registry
+from render.physics.stepper import Run
 from render.config.scene import load
 
 W, H, FPS = 256, 144, 30
@@ -12,13 +12,13 @@ W, H, FPS = 256, 144, 30
 def bob_pixels_over_the_run(name, *sets):
     """Every bob's pixel position (the canvas's own transform) at every frame of the whole run."""
     scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", 'effects=["bobs"]', *sets])
-    runtime.init("cpu", scene.integrator.precision)
     from render.draw.canvas import Canvas
 
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     canvas = Canvas(scene, sim)
     seen = []
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         canvas.launch("bob_pixels")
         seen.append(canvas.pos.to_numpy())
     return scene, sim, canvas, np.stack(seen)  # (frames, N, bobs, 2)

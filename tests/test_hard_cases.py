@@ -16,18 +16,17 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import ROOT, make_scene, out_folder, run_cli
-from render.video import pipeline
-from render.physics import runtime
+from render.physics.stepper import Run
 
 FAN = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
 
 
 def simulate(scene, every_frame=False):
     """Run the scene without drawing; returns (system, per-frame max drift if asked)."""
-    runtime.init("cpu", scene.integrator.precision)
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     drifts = []
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         if every_frame:
             e, e0, s = sim.e.to_numpy(), sim.e0.to_numpy(), sim.escale.to_numpy()
             drifts.append(np.max(np.abs(e - e0) / s))
@@ -89,10 +88,10 @@ def test_spring_through_its_anchor():
     """A soft spring lets the outer bob fall through the inner one: length ~0 must not give NaN."""
     scene = make_scene("elastic", 1, pendulums={"theta1": 0.0, "theta2": math.pi, "stiffness": 2.0},
                        integrator={"method": "verlet"}, video={"fps": 100, "duration": 3.0})
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     shortest = math.inf
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         pos = sim.state()["pos"][0]
         shortest = min(shortest, np.linalg.norm(pos[1] - pos[0]))
     assert shortest < 0.05 * scene.pendulums.lengths[1]
@@ -108,10 +107,10 @@ def test_a_hundred_thousand_pendulums():
 def test_smallest_spread_resolvable_in_f64():
     """Neighbours 1e-14 rad apart (~20 ulps at θ≈3) start distinct and stay distinct, in order."""
     scene = rigid(100, 2.0, fps=10, theta1=2.6, theta2=3.0, spread=1e-12, integrator={"dt": 1e-3})
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     assert len(np.unique(sim.q.to_numpy()[:, 1])) == 100
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         pass
     th2 = sim.q.to_numpy()[:, 1]
     assert np.isfinite(th2).all() and len(np.unique(th2)) == 100

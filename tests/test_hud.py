@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from render.draw import hud
-from render.video import pipeline
-from render.physics import runtime
+from render.physics.stepper import Run
 from render.config.scene import load
 
 W, H, FPS = 256, 144, 10
@@ -18,13 +17,13 @@ def run(name, info=None, upto=None, sets=()):
     """Draw a preset's frames with the HUD on (small, short); returns the canvas, the frames and the system."""
     scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", "video.duration=0.5",
                         'effects=["bobs", "hud"]', *sets])
-    runtime.init("cpu", scene.integrator.precision)
     from render.draw.canvas import Canvas
 
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     canvas = Canvas(scene, sim, info)
     frames = []
-    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for f in run.frames():
         frames.append(canvas.draw(t=f / FPS).copy())
         if f == upto:
             break
@@ -104,18 +103,17 @@ SCRIPT = """
 import hashlib, sys
 import numpy as np
 from render.draw import hud
-from render.video import pipeline
-from render.physics import runtime
+from render.physics.stepper import Run
 from render.config.scene import load
 threads = int(sys.argv[1])
 for w, h, panel in ((1280, 720, False), (640, 360, True)):
     scene = load("rigid_chaos", [f"video.width={w}", f"video.height={h}", "video.fps=60", "video.duration=0.5"])
-    runtime.init("cpu", "f64", threads)
-    sim = pipeline.make_system(scene)
+    run = Run(scene, "cpu", threads)
+    sim = run.sim
     info = hud.Info(scene.description, "rk4", 1e-3, "f64", faithful_until_s=0.15, median_until_s=0.3, panel=panel)
     h_ = hud.Hud(scene, sim, info, w, h)
     digest, lit = hashlib.sha256(), set()
-    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for f in run.frames():
         out = np.zeros((h, w, 3), np.uint8)
         out[::7, ::5] = 40  # something under the HUD for its max
         h_.draw(out, f / 60)

@@ -1,6 +1,6 @@
 """The integrators against an independent DOP853 reference: convergence order, accuracy, energy, symplecticity.
 
-Each test calls runtime.init with the precision it needs (one Taichi runtime per process, re-initialised).
+Each run starts Taichi in the precision it needs (render/physics/stepper.py: one runtime per process, re-initialised).
 """
 import math
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from render.commands import accuracy
-from render.physics import integrators, reference, runtime
-from render.video.pipeline import make_system
+from render.physics import integrators, reference, registry
+from render.physics.stepper import Run
 from render.config.scene import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
@@ -47,13 +47,12 @@ def traj_error(system, method, precision, dt, ref):
 
 def test_reference_agrees_with_itself_and_with_taichi_start(refs):
     """The reference is converged (tightening rtol changes little) and starts where the Taichi systems start."""
-    runtime.init("cpu", "f64")
     sc = accuracy.case_scene("rigid", "rk4", "f64", 1e-3, 2.0)
     loose = reference.solve(sc, reference.initial_state(sc), 2.0, rtol=1e-11, atol=1e-11)[0]
     assert np.abs(loose - refs["rigid"][0]).max() < 1e-9
     for system in ("rigid", "elastic"):
         sc = accuracy.case_scene(system, "rk4", "f64", 1e-3, 1.0)
-        sim = make_system(sc)
+        sim = Run(sc).sim
         q0, v0 = reference.initial_state(sc)
         np.testing.assert_allclose(sim.q.to_numpy(), q0, rtol=0, atol=1e-15)
         np.testing.assert_allclose(sim.v.to_numpy(), v0, rtol=0, atol=1e-15)
@@ -61,7 +60,6 @@ def test_reference_agrees_with_itself_and_with_taichi_start(refs):
 
 @pytest.mark.parametrize("system,method", CASES)
 def test_observed_order_matches_theory(system, method, refs):
-    runtime.init("cpu", "f64")
     errs = [traj_error(system, method, "f64", dt, refs[system]) for dt in LADDER]
     slope = np.polyfit(np.log(LADDER), np.log(errs), 1)[0]
     assert abs(slope - THEORY[method]) <= 0.3, f"{system} {method}: errors {errs}, observed order {slope:.2f}"
@@ -69,7 +67,6 @@ def test_observed_order_matches_theory(system, method, refs):
 
 def test_rk4_f64_matches_reference_on_classic(refs):
     """classic (θ1 = 120°, θ2 = −10°): RK4 at dt = 1e-3 in f64 is within 1e-8 rad of DOP853 at t = 2 s."""
-    runtime.init("cpu", "f64")
     sc = accuracy.case_scene("rigid", "rk4", "f64", 1e-3, 2.0)
     assert sc.pendulums.theta1 == pytest.approx(math.radians(120))
     assert sc.pendulums.theta2 == pytest.approx(math.radians(-10))
@@ -80,9 +77,7 @@ def test_rk4_f64_matches_reference_on_classic(refs):
 @pytest.mark.parametrize("system,method", CASES)
 def test_f32_is_f32_and_as_good_as_its_round_off(system, method, refs):
     """In f32 every method tracks its f64 error down to f32 round-off; rk4 is visibly limited by it."""
-    runtime.init("cpu", "f32")
     e32 = traj_error(system, method, "f32", 1e-3, refs[system])
-    runtime.init("cpu", "f64")
     e64 = traj_error(system, method, "f64", 1e-3, refs[system])
     assert e32 <= 1.2 * e64 + 1e-4
     if method == "rk4":  # f64 arithmetic behind an "f32" label would give ~e64 here
@@ -91,7 +86,6 @@ def test_f32_is_f32_and_as_good_as_its_round_off(system, method, refs):
 
 def energy_error(system, method, steps=100_000, dt=1e-3):
     """Relative energy error per frame (0.1 s), worst pendulum, over `steps` steps in f64."""
-    runtime.init("cpu", "f64")
     sc = accuracy.case_scene(system, method, "f64", dt, steps * dt)
     _, _, series = accuracy.advance(sc, 1, round(steps * dt * accuracy.FPS) - 1)
     return series[1:]
@@ -122,11 +116,10 @@ def test_energy_check_detects_rk4_drift():
 
 def one_step_jacobian(system, method, y, to_canon, from_canon, h=1e-2, eps=1e-5):
     """Jacobian of one Taichi step in canonical coordinates, by central differences over 2·dim pendulums."""
-    runtime.init("cpu", "f64")
     dim = len(y)
     sc = accuracy.case_scene(system, method, "f64", h, 1.0).replace(pendulums={"count": 2 * dim})
     assert sc.pendulums.masses == (1.0, 1.0) and sc.pendulums.lengths == (1.0, 1.0)  # as the helpers assume
-    sim = make_system(sc)
+    sim = Run(sc).sim
     ys = np.array([y + s * eps * np.eye(dim)[k] for k in range(dim) for s in (1, -1)])
     q, v = from_canon(ys)
     sim.q.from_numpy(q)
@@ -179,11 +172,10 @@ def test_every_quality_level_is_stable_on_every_preset():
     from render.trust.quality import LEVELS
     from render.config.scene import list_presets, load
 
-    runtime.init("cpu", "f64")
     for path in list_presets():
         for level in LEVELS:
             sc = load(str(path), quality=level)
             small = {"video": {"width": 16, "height": 16}} if sc.pendulums.layout == "grid" else {}
             sc = sc.replace(**small) if small else sc.replace(pendulums={"count": 1})  # a grid counts its pixels
-            sim = make_system(sc)  # raises SceneError beyond the method's stability limit
+            sim = registry.get(sc.system)(sc, allocate=False)  # raises SceneError beyond the method's stability limit
             assert sim.h <= (sc.integrator.dt if sc.integrator.dt != "auto" else 1e-3) + 1e-15

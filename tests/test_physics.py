@@ -4,8 +4,8 @@ import pytest
 import taichi as ti
 
 from conftest import make_scene
-from render.video import pipeline
-from render.physics import reference, runtime
+from render.physics import reference
+from render.physics.stepper import Run
 
 SYSTEMS = {
     "rigid": dict(pendulums={"theta1": 2.0, "theta2": -0.5, "omega1": 0.3, "omega2": -1.0, "spread": 0.4,
@@ -28,9 +28,8 @@ def force_and_energy(sim: ti.template(), acc: ti.types.ndarray(), e: ti.types.nd
 
 @pytest.mark.parametrize("system", SYSTEMS)
 def test_accelerations_and_energy_at_random_states(system):
-    runtime.init("cpu", "f64")
     scene = make_scene(system, 64, effects=["energy"], video={"fps": 10, "duration": 0.1}, **SYSTEMS[system])
-    sim = pipeline.make_system(scene)
+    sim = Run(scene).sim
     rng = np.random.default_rng(7)
     d = sim.D
     scale = 1.0 if system == "rigid" else 0.6
@@ -46,12 +45,12 @@ def test_accelerations_and_energy_at_random_states(system):
 
 @pytest.mark.parametrize("system", SYSTEMS)
 def test_short_trajectory_matches_dop853(system):
-    runtime.init("cpu", "f64")
     scene = make_scene(system, 5, video={"fps": 20, "duration": 1.05}, **SYSTEMS[system])
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     q0, v0 = sim.q.to_numpy(), sim.v.to_numpy()
     np.testing.assert_allclose(np.stack([q0, v0]), np.stack(reference.initial_state(scene)), atol=1e-15)
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         pass
     q_ref, v_ref = reference.solve(scene, (q0, v0), sim.t, rtol=1e-12, atol=1e-12)
     assert sim.t == pytest.approx(1.0)
@@ -63,10 +62,10 @@ def test_rk4_f64_conserves_energy_on_classic_for_10_s():
     from render.config.scene import load
     scene = load("classic", ["video.duration=10.05", "video.fps=20"])
     assert scene.integrator.method == "rk4" and scene.integrator.precision == "f64"
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     worst = 0.0
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for _ in run.frames():
         worst = max(worst, abs(sim.e[0] - sim.e0[0]) / abs(sim.e0[0]))
     assert sim.t == pytest.approx(10.0)
     assert worst < 1e-6, worst
@@ -78,15 +77,15 @@ def test_libm_trig_is_an_option_that_agrees_with_inline_on_a_regular_orbit():
     on an orbit that is not chaotic (small swings, so last-bit differences do not grow), it and the inline
     sin/cos both match DOP853, and each other to round-off."""
     from render.config.scene import load
-    runtime.init("cpu", "f64")
     ends = {}
     for trig in ("libm", "inline"):
         scene = load("classic", ["pendulums.theta1=0.3", "pendulums.theta2=0.2", "video.duration=5.05",
                                  "video.fps=20", f'integrator.trig="{trig}"'])
-        sim = pipeline.make_system(scene)
+        run = Run(scene)
+        sim = run.sim
         assert sim.libm == (trig == "libm")
         q0, v0 = sim.q.to_numpy(), sim.v.to_numpy()
-        for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        for _ in run.frames():
             pass
         q_ref, _ = reference.solve(scene, (q0, v0), sim.t, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(sim.q.to_numpy(), q_ref, atol=1e-9)

@@ -8,7 +8,8 @@ from scipy.integrate import solve_ivp
 
 from conftest import run_cli
 from render.video import pipeline
-from render.physics import poincare, reference, runtime
+from render.physics import poincare, reference
+from render.physics.stepper import Run
 from render.errors import SceneError
 from render.config.scene import load
 
@@ -49,13 +50,14 @@ def test_crossings_agree_with_scipy_event_location_where_the_certificate_trusts(
     scene = scene_of("pendulums.count=8", f"video.duration={duration}", "video.fps=60",
                      "integrator.tolerance=1e-7", "integrator.min_faithful=0")
     scene, _, cert, _ = pipeline.prepare(scene, "cpu", None)
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
+    run = Run(scene)
+    sim = run.sim
     q0, v0 = sim.initial_state()
     assert (q0[:, 0] == 0).all() and (v0[:, 0] > 0).all()
     found = [[] for _ in range(sim.n)]
-    for _ in range(scene.frames - 1):
-        sim.advance_frame()
+    for f in run.frames():
+        if not f:
+            continue
         i, t, th2, w2, lost = poincare.read(sim, sim.t - sim.substeps * sim.h)
         assert lost == 0
         for row in zip(i, t, th2, w2):
@@ -83,8 +85,7 @@ def test_crossings_agree_with_scipy_event_location_where_the_certificate_trusts(
 def test_the_shell_starts_every_pendulum_on_the_section_with_the_presets_energy():
     """The start is built from the reference model's energy; the Taichi system's own energy agrees."""
     scene = scene_of("video.duration=0.1")
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
+    sim = Run(scene).sim
     sim.measure_energy(first=True)
     p = scene.pendulums
     want = 0.5 * (p.masses[0] + p.masses[1]) * p.lengths[0] ** 2 * p.omega1 ** 2  # hanging start: all kinetic

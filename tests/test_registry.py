@@ -151,3 +151,37 @@ def test_every_system_declares_its_contract(name):
     preset, horizon = cls.ACCURACY_CASE
     assert load(preset).system == name and horizon > 0 and 1e-3 in cls.ACCURACY_LADDER
     assert {f"theta{k}" for k in range(1, len(cls.LINKS) + 1)} <= set(cls.preset_keys())
+
+
+def starts_taichi_or_builds_a_system(path: Path) -> list[str]:
+    """runtime.init(...) or ti.init(...) calls, and systems built with fields: registry.get(...)(...) without
+    allocate=False."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if not isinstance(node, ast.Call):
+            continue
+        f = node.func
+        if isinstance(f, ast.Attribute) and f.attr == "init" and isinstance(f.value, ast.Name) and \
+                f.value.id in ("runtime", "ti"):
+            found.append(f"{node.lineno}: {f.value.id}.init")
+        planned = any(k.arg == "allocate" and isinstance(k.value, ast.Constant) and k.value.value is False
+                      for k in node.keywords)
+        if isinstance(f, ast.Call) and isinstance(f.func, ast.Attribute) and f.func.attr == "get" and \
+                isinstance(f.func.value, ast.Name) and f.func.value.id == "registry" and not planned:
+            found.append(f"{node.lineno}: a system built")
+    return found
+
+
+def test_only_the_frame_loop_starts_taichi_and_builds_systems():
+    """render/physics/stepper.py starts Taichi for the system it builds, so no caller has an order of calls to
+    keep (runtime.py's own ti.init aside)."""
+    offenders = {}
+    for path in sorted(PKG.rglob("*.py")):
+        rel = path.relative_to(PKG).as_posix()
+        if rel not in ("physics/stepper.py", "physics/runtime.py"):
+            if found := starts_taichi_or_builds_a_system(path):
+                offenders[rel] = found
+    assert not offenders, offenders
+    kinds = {f.split(": ")[1] for f in starts_taichi_or_builds_a_system(PKG / "physics" / "stepper.py")}
+    assert kinds == {"runtime.init", "a system built"}  # the check sees both
+    assert any("ti.init" in f for f in starts_taichi_or_builds_a_system(PKG / "physics" / "runtime.py"))

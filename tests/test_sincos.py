@@ -5,8 +5,8 @@ import pytest
 import taichi as ti
 
 from conftest import make_scene
-from render.video import pipeline
 from render.physics import runtime
+from render.physics.stepper import Run
 from render.physics.sincos import sincos
 
 LANES = 8
@@ -105,13 +105,13 @@ def test_sincos_gives_nan_where_it_cannot_be_right(precision):
 
 def advanced(system, method, precision, q0, v0, threads, frames=3):
     """State after `frames` frames from (q0, v0), one pendulum per row, at the given thread count."""
-    runtime.init("cpu", precision, threads)
     scene = make_scene(system, len(q0), integrator={"method": method, "dt": 2e-3, "precision": precision},
                        video={"fps": 10, "duration": 1.0})
-    sim = pipeline.make_system(scene)
+    run = Run(scene, "cpu", threads)
+    sim = run.sim
     sim.load(q0, v0)
-    for _ in range(frames):
-        sim.advance_frame()
+    for _ in run.frames(frames + 1):
+        pass
     return sim.q.to_numpy(), sim.v.to_numpy()
 
 

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import make_scene, run_cli
-from render.physics import integrators, registry, runtime
-from render.video import pipeline
+from render.physics import integrators, registry
+from render.physics.stepper import Run
 from render.errors import SimulationError
 
 STARTS = 20
@@ -38,11 +38,10 @@ def stated_limit(scene) -> float:
 
 def run(scene):
     """The scene through the System's advance and the watchdog, as a render steps it."""
-    runtime.init("cpu", "f64")
-    sim = pipeline.make_system(scene)
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    runner = Run(scene)
+    for _ in runner.frames():
         pass
-    return sim
+    return runner.sim
 
 
 @pytest.mark.slow  # 40 scenes, each compiles its kernels: about a minute per method

@@ -7,8 +7,8 @@ import pytest
 import taichi as ti
 
 from conftest import make_scene, run_cli
-from render.video import pipeline
-from render.physics import reference, runtime
+from render.physics import reference
+from render.physics.stepper import Run
 
 PEND = {"theta1": 2.0, "theta2": -0.5, "theta3": 2.8, "omega1": 0.3, "omega2": -1.0, "omega3": 0.7,
         "spread": 0.4, "lengths": [1.0, 0.7, 0.5], "masses": [1.5, 0.8, 1.2], "gravity": 9.81}
@@ -20,11 +20,10 @@ def triple(count=5, duration=1.0, fps=20, method="rk4", dt=1e-3, **pend):
 
 
 def run(scene):
-    runtime.init("cpu", scene.integrator.precision)
-    sim = pipeline.make_system(scene)
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    runner = Run(scene)
+    for _ in runner.frames():
         pass
-    return sim
+    return runner.sim
 
 
 @ti.kernel
@@ -37,9 +36,8 @@ def force_and_energy(sim: ti.template(), acc: ti.types.ndarray(), e: ti.types.nd
 
 
 def test_accelerations_and_energy_match_the_chain_reference_at_random_states():
-    runtime.init("cpu", "f64")
     scene = triple(64)
-    sim = pipeline.make_system(scene)
+    sim = Run(scene).sim
     rng = np.random.default_rng(11)
     q, v = rng.uniform(-np.pi, np.pi, (64, 3)), rng.normal(0, 2.0, (64, 3))
     sim.q.from_numpy(q)
@@ -71,9 +69,9 @@ def test_rk4_order_is_four():
 
 def energy_errors(scene):
     """Max relative energy error over the pendulums, per frame."""
-    runtime.init("cpu", "f64")
-    sim, out = pipeline.make_system(scene), []
-    for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    runner, out = Run(scene), []
+    sim = runner.sim
+    for _ in runner.frames():
         out.append(np.max(np.abs(sim.e.to_numpy() - sim.e0.to_numpy()) / sim.escale.to_numpy()))
     return np.array(out)
 

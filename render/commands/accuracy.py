@@ -3,7 +3,7 @@
 Per system, method, precision and step dt it measures the trajectory error at a short horizon, the energy
 drift over that horizon, the kernel's wall time per pendulum-step (over a large N) and the observed order;
 then it draws work-precision, long-run energy-drift and f32-vs-f64 divergence charts into OUT/.
-Precision is fixed per Taichi init, so f64 and f32 run one after the other with a re-init in between.
+Precision is fixed per Taichi init, so all f64 runs come first, then all f32 ones: one restart in between.
 """
 from __future__ import annotations
 
@@ -17,10 +17,10 @@ import numpy as np
 
 from . import charts, flagship
 from ..trust import quality
-from ..physics import reference, registry, runtime
+from ..physics import reference, registry
+from ..physics.stepper import Run
 from ..video.atomic import write_atomic
 from ..config.options import check_writable
-from ..video.pipeline import make_system
 from ..config.scene import METHODS, PRECISIONS, load
 
 COLUMNS = ("system", "method", "precision", "dt", "traj_error", "energy_drift", "ns_per_step", "order")
@@ -57,36 +57,33 @@ def case_scene(system: str, method: str, precision: str, dt: float, duration: fl
                                           video={"fps": FPS, "duration": duration}, effects=["energy"])
 
 
-def advance(scene, frames: int, more: int = 0):
+def advance(scene, frames: int, more: int = 0, arch: str = "cpu"):
     """Advance a fresh system by `frames` frames, then `more`.
 
     Returns (q at `frames` in float64, max relative energy drift up to there, and with `more` the relative
     energy error (E − E0)/scale per pendulum at every frame, shape (frames + more + 1, N)).
     """
-    sim = make_system(scene)
-    sim.measure_energy(first=True)
-    drift = float(sim.drift[None])
-    series = None
-    if more:
-        e0, scale = (f.to_numpy().astype(np.float64) for f in (sim.e0, sim.escale))
-        series = np.zeros((frames + more + 1, sim.n))
-    for f in range(1, frames + more + 1):
-        sim.advance_frame()
-        sim.measure_energy()
+    run = Run(scene, arch)
+    sim, series = run.sim, None
+    # No watchdog: the coarse rungs may blow up or drift, and that is what is measured.
+    for f in run.frames(frames + more + 1, energy=True, watch=False):
         if f <= frames:
             drift = float(sim.drift[None])
-        if more:
+        if more and not f:  # the energies of frame 0 are the reference
+            e0, scale = (x.to_numpy().astype(np.float64) for x in (sim.e0, sim.escale))
+            series = np.zeros((frames + more + 1, sim.n))
+        elif more:
             series[f] = (sim.e.to_numpy().astype(np.float64) - e0) / scale
         if f == frames:
             q = sim.q.to_numpy().astype(np.float64)
     return q, drift, series
 
 
-def timing_kernel(scene, n: int, target_s: float = 0.02):
+def timing_kernel(scene, n: int, arch: str = "cpu", target_s: float = 0.02):
     """A compiled advance kernel over n pendulums, as (launch, steps per timed launch ≈ target_s, n)."""
     import taichi as ti
 
-    sim = make_system(scene.replace(pendulums={"count": n}))
+    sim = Run(scene.replace(pendulums={"count": n}), arch).sim
     kernel = f"{sim.NAME}_advance"
 
     def launch(k):
@@ -110,16 +107,12 @@ def ns_per_step(kernels: dict, rounds: int = 5) -> dict:
     return best
 
 
-def outer_bobs(scene, duration: float, fps: int = CHAOS_FPS) -> np.ndarray:
+def outer_bobs(scene, duration: float, arch: str = "cpu", fps: int = CHAOS_FPS) -> np.ndarray:
     """Outer-bob positions (frames, N, 2) of a scene sampled at fps, computed in float64 from the state."""
     scene = scene.replace(video={"fps": fps, "duration": duration}, effects=["bobs"])
-    sim = make_system(scene)
-    frames = []
-    for f in range(scene.frames):
-        if f:
-            sim.advance_frame()
-        frames.append(reference.bob_positions(scene, sim.q.to_numpy().astype(np.float64))[:, -1])
-    return np.array(frames)
+    run = Run(scene, arch)
+    return np.array([reference.bob_positions(scene, run.sim.q.to_numpy().astype(np.float64))[:, -1]
+                     for _ in run.frames(watch=False)])
 
 
 def observed_orders(dts, errs) -> list[float]:
@@ -147,7 +140,6 @@ def measure(systems, arch="cpu", quick=False, show=False):
     step = progress(per_prec * len(PRECISIONS) + fan * len(PRECISIONS) + len(quality.LEVELS) * chaos_on, show)
     rows, energy, chaos = [], {}, {}
     for prec in ("f64", "f32"):  # f64 first: its figures are the ones the quality table leans on
-        runtime.init(arch, prec)
         kernels, block = {}, []
         for s in systems:
             horizon = CASES[s][1]
@@ -156,15 +148,15 @@ def measure(systems, arch="cpu", quick=False, show=False):
                 # An explicit step costs the same at any dt: time it once (less noise, fewer compiles).
                 # The implicit one iterates more at larger dt, so it is timed on every rung.
                 if method != "implicit_midpoint":
-                    kernels[(s, method)] = timing_kernel(case_scene(s, method, prec, LONG_DT, horizon), n_time)
+                    kernels[(s, method)] = timing_kernel(case_scene(s, method, prec, LONG_DT, horizon), n_time, arch)
                 errs = []
                 for dt in ladder[s]:
                     sc = case_scene(s, method, prec, dt, horizon)
                     if method == "implicit_midpoint":
-                        kernels[(s, method, dt)] = timing_kernel(sc, n_time)
+                        kernels[(s, method, dt)] = timing_kernel(sc, n_time, arch)
                     # The preset-dt rung runs on for the long energy-drift series.
                     more = round((long_t - horizon) * FPS) if dt == LONG_DT else 0
-                    q, drift, series = advance(sc, frames, more)
+                    q, drift, series = advance(sc, frames, more, arch)
                     if series is not None:
                         energy[(s, method, prec)] = series
                     err = float(np.max(np.abs(q - refs[s]))) if np.all(np.isfinite(q)) else math.inf
@@ -182,7 +174,7 @@ def measure(systems, arch="cpu", quick=False, show=False):
         step(f"{prec}: timed {len(kernels)} kernels over N = {n_time}")
         if chaos_on:
             chaos[prec] = outer_bobs(load(CHAOS).replace(integrator={"precision": prec}),
-                                     QUICK_CHAOS_T if quick else CHAOS_T)
+                                     QUICK_CHAOS_T if quick else CHAOS_T, arch)
             step(f"{CHAOS} {prec}: divergence")
     fan_rows = quality_rows = []
     if chaos_on:

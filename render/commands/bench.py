@@ -176,18 +176,16 @@ def phase_sim(cfg, arch, tmp) -> dict:
     interleaved rounds; at N = 1e5 the numba peer too, and for the rigid kernel render/peak.py's peak rate,
     whose ratio to the kernel's flop rate is rigid_rk4_peak_fraction."""
     import taichi as ti
-    from ..video import pipeline
-    from ..physics import runtime
+    from ..physics.stepper import Run
     from ..config.scene import load
 
     rows, peaks = [], {}
     for prec in ("f32", "f64"):
-        runtime.init(arch, prec)
         for preset in SIM_PRESETS:
             for n in cfg["ladder"]:
                 scene = load(preset, [f"pendulums.count={n}", 'integrator.method="rk4"', "integrator.dt=1e-3",
                                       f'integrator.precision="{prec}"', 'effects=["bobs"]'])  # no energy
-                sim = pipeline.make_system(scene)
+                sim = Run(scene, arch).sim
                 kern, q0, v0 = f"{sim.NAME}_advance", sim.q.to_numpy().T.copy(), sim.v.to_numpy().T.copy()
                 if n == cfg["ladder"][0]:  # first check that both integrate the same thing
                     base = Baseline(scene, q0, v0, sim.h)
@@ -256,17 +254,16 @@ def chaos_scene(cfg):
 def phase_encode(cfg, arch, tmp) -> dict:
     """Draw rigid_chaos's frames into a raw file (timing simulate and draw), then time only the encoding of
     those frames (memory-mapped) through the same Encoder: the floor an end-to-end render cannot beat."""
-    from ..video import pipeline
-    from ..physics import runtime
+    from ..physics.stepper import Run
     from ..draw.canvas import Canvas
     from ..video.encode import Encoder
 
     scene = chaos_scene(cfg)
-    runtime.init(arch, scene.integrator.precision)
-    sim = pipeline.make_system(scene)
+    run = Run(scene, arch)
+    sim = run.sim
     canvas, raw, timings, draw = Canvas(scene, sim), tmp / "frames.raw", {"simulate": 0.0}, 0.0
     with open(raw, "wb") as fh:
-        for f in pipeline.frames(scene, sim, timings):
+        for f in run.frames(timings=timings):
             if f == 2:  # frames 0 and 1 instantiate the kernels; time the steady state
                 timings["simulate"], draw = 0.0, 0.0
             t = time.perf_counter()
@@ -323,16 +320,15 @@ def phase_rainbow(cfg, arch, tmp) -> dict:
     """Drawing fps of rainbow_1000 (1000 pendulums, glow, 720p) over its whole video, the spray included (the
     quick run: its first 3 s, still coherent), timed per frame like the encode phase: frames 0 and 1
     instantiate kernels."""
-    from ..video import pipeline
-    from ..physics import runtime
+    from ..physics.stepper import Run
     from ..draw.canvas import Canvas
     from ..config.scene import load
 
     scene = load(RAINBOW, [f"video.duration={cfg['rainbow_s']}"] if cfg["rainbow_s"] else [])
-    runtime.init(arch, scene.integrator.precision)
-    sim = pipeline.make_system(scene)
+    run = Run(scene, arch)
+    sim = run.sim
     canvas, timings, draw, frame = Canvas(scene, sim), {"simulate": 0.0}, 0.0, canvas_frame(scene)
-    for f in pipeline.frames(scene, sim, timings):
+    for f in run.frames(timings=timings):
         if f == 2:
             timings["simulate"], draw = 0.0, 0.0
         t = time.perf_counter()
@@ -352,15 +348,14 @@ def phase_hud(cfg, arch, tmp) -> dict:
     certificate as in benchmarks/effects.py): drawn onto a blank frame at every frame of the simulation, so its
     spread is the live one; the median over the frames after the first two (which compile)."""
     import taichi as ti
-    from ..video import pipeline
-    from ..physics import runtime
+    from ..physics.stepper import Run
     from ..draw.hud import Hud, Info
 
     scene = chaos_scene(cfg)
-    runtime.init(arch, scene.integrator.precision)
-    sim, v = pipeline.make_system(scene), scene.video
+    run = Run(scene, arch)
+    sim, v = run.sim, scene.video
     hud, frame, ms = Hud(scene, sim, Info.of(scene), v.width, v.height), canvas_frame(scene), []
-    for f in pipeline.frames(scene, sim, {"simulate": 0.0}):
+    for f in run.frames():
         frame.fill(0)
         t = time.perf_counter()
         hud.draw(frame, f / v.fps)
@@ -372,23 +367,21 @@ def phase_hud(cfg, arch, tmp) -> dict:
 def draw_timer(scene, arch):
     """once(): frames per second of simulating and drawing all the scene's frames, nothing encoded, from the
     start each time (the first call compiles)."""
-    from ..video import pipeline
-    from ..physics import runtime
+    from ..physics.stepper import Run
     from ..draw.canvas import Canvas
 
     built = {}
 
     def once() -> float:
-        if built.get("generation") != runtime.generation():  # a render in between re-initialised Taichi
-            runtime.init(arch, scene.integrator.precision)
-            sim = pipeline.make_system(scene)
-            built.update(generation=runtime.generation(), sim=sim, canvas=Canvas(scene, sim))
+        if "run" not in built or not built["run"].current:  # a render in between re-initialised Taichi
+            run = Run(scene, arch)
+            built.update(run=run, canvas=Canvas(scene, run.sim))
             once()  # compiles
-        sim, canvas, frame = built["sim"], built["canvas"], canvas_frame(scene)
-        sim.restart()
+        run, canvas, frame = built["run"], built["canvas"], canvas_frame(scene)
+        run.sim.restart()
         canvas.restart()
         t = time.perf_counter()
-        for _ in pipeline.frames(scene, sim, {"simulate": 0.0}):
+        for _ in run.frames():
             canvas.draw(frame)
         return scene.frames / (time.perf_counter() - t)
     once()

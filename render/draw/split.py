@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..physics import integrators, registry, runtime
+from ..physics.stepper import Run
 from .font import text_height
 from .hud import faces, step
 
@@ -136,13 +137,16 @@ class Replay:
     """One variant's recorded states drawn at its panel's size by the canvas `render` draws with: a frame
     source with pipeline.Source's interface (name, frames, index, reset(), next_frame(out=None))."""
 
-    def __init__(self, scene, q: np.ndarray, cert):
+    def __init__(self, scene, q: np.ndarray, cert, arch: str = "cpu", threads: int | None = None,
+                 keep_log: bool = False):
         from .canvas import Canvas
         from .hud import Info
 
         self.scene, self.q = scene, q
         self.name, self.frames = scene.name, len(q)
-        self.sim = registry.get(scene.system)(scene)
+        # pass 2 draws every panel from f64 positions (in f32 pixels as ever), all panels in one runtime's log
+        self.run = Run(scene, arch, threads, precision="f64", keep_log=keep_log)
+        self.sim = self.run.sim
         # the HUD, if called for, with the variant's own certificate: its clock's colours and timeline ticks
         self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True))
         self.reset(rewind=False)
@@ -173,9 +177,10 @@ class SplitScreen:
         self.ref = finest(self.runs)
         v = scene.video
         self.rects = layout(v.width, v.height, len(self.runs))
-        self.arch = runtime.init(arch, "f64", threads)  # pass 2: f64 positions, drawn in f32 pixels as ever
-        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"])
-                       for run, (_, _, w, h) in zip(self.runs, self.rects)]
+        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"], arch,
+                              threads, keep_log=k > 0)
+                       for k, (run, (_, _, w, h)) in enumerate(zip(self.runs, self.rects))]
+        self.arch = self.panels[0].run.arch
         self.buffers = [p.canvas.new_frame() for p in self.panels]
         self.angles = registry.get(scene.system).ANGLES
         ref_q, sim = self.runs[self.ref]["q"], self.panels[self.ref].sim

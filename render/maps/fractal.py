@@ -110,8 +110,7 @@ class Map(runtime.Launcher):
         self.lay = grid.layout(v.width, v.height)
         self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
         self.twins = self.kind == "divergence"
-        # pendulums per kernel iteration: the system's lanes, and a whole number of pairs
-        self.lanes = sim.LANES * (2 if self.twins and sim.LANES % 2 else 1)
+        self.lanes = 2 if self.twins else 1  # pendulums per kernel iteration: a pixel, or a pixel and its twin
         self.groups = -(-sim.n // self.lanes)
         self.barrier = min(barriers(sim.masses, sim.lengths, sim.g))
         self.eps, self.threshold = scene.map.epsilon, scene.map.threshold
@@ -133,14 +132,14 @@ class Map(runtime.Launcher):
         return np.empty((self.lay.height, self.lay.width, 3), np.uint8)  # draw() writes every pixel
 
     # ------------------------------------------------------------ host side
-    def advance_frame(self):
-        """One frame on: the angles map is the plain advance; the others stop each pixel at its event."""
+    def advance(self, substeps: int, h: float):
+        """One frame on, for the frame loop (render/physics/stepper.py, which keeps the clock): the angles map is
+        the plain advance; the others stop each pixel at its event."""
         sim = self.sim
         if self.kind == "angles":
-            sim.advance_frame()
-            return
-        self.launch("fractal_advance", sim.substeps, sim.h, sim.t)
-        sim.t += sim.substeps * sim.h
+            sim.launch(f"{sim.NAME}_advance", substeps, h)
+        else:
+            self.launch("fractal_advance", substeps, h, sim.t)
 
     def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
         """The map at the simulation's time (t, the canvas's clock argument, is the same and unused here)."""
@@ -212,7 +211,7 @@ class Map(runtime.Launcher):
 
     @ti.func
     def gather(self, g):
-        """System.gather at this map's width (a pair never straddles two groups)."""
+        """The group's state as lane matrices (a pair never straddles two groups); the last pendulum pads."""
         last = self.sim.n - 1
         q = ti.Matrix.cols([self.sim.q[ti.min(g * self.lanes + lane, last)] for lane in ti.static(range(self.lanes))])
         v = ti.Matrix.cols([self.sim.v[ti.min(g * self.lanes + lane, last)] for lane in ti.static(range(self.lanes))])
@@ -220,13 +219,12 @@ class Map(runtime.Launcher):
 
     @ti.func
     def scatter(self, g, q, v):
-        """System.scatter at this map's width, with the same watchdog."""
+        """The group's state back into the system's fields, each pendulum through its watchdog."""
         for lane in ti.static(range(self.lanes)):
             i = g * self.lanes + lane
             if i < self.sim.n:
                 self.sim.q[i], self.sim.v[i] = q[:, lane], v[:, lane]
-                if not (ti.abs(q[:, lane]).max() < 1e30 and ti.abs(v[:, lane]).max() < 1e30):  # also NaN
-                    ti.atomic_min(self.sim.bad[None], i)
+                self.sim.watch(i, q[:, lane], v[:, lane])
 
     @ti.kernel
     def fractal_advance(self, substeps: ti.i32, h: float, t0: float):

@@ -100,13 +100,12 @@ class FtleMap(fractal.Map):
         """M = I and L = 0 at every pixel, from the system's current (initial) state."""
         self.launch("ftle_setup")
 
-    def advance_frame(self):
-        sim = self.sim
+    def advance(self, substeps: int, h: float):
+        """One frame on, for the frame loop (render/physics/stepper.py, which keeps the clock)."""
         self.out.dual.fill(0)  # forward mode adds into the output's duals
         with scalarized(), ti.ad.FwdMode(loss=self.loss, param=self.unit, seed=[1.0], clear_gradients=False):
-            self.launch("ftle_frame", self.twin, sim.substeps, sim.h)
+            self.launch("ftle_frame", self.twin, substeps, h)
         self.launch("ftle_renormalise")
-        sim.t += sim.substeps * sim.h
 
     def tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """(M, L): per pixel the k×k matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
@@ -169,8 +168,7 @@ class FtleMap(fractal.Map):
             x = self.out[K * p]
             self.sim.q[p] = ti.Vector([x[c] for c in ti.static(range(D))])
             self.sim.v[p] = ti.Vector([x[D + c] for c in ti.static(range(D))])
-            if not (ok and ti.abs(x).max() < 1e30):
-                ti.atomic_min(self.sim.bad[None], p)
+            self.sim.watch(p, x, ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
 
     @ti.func
     def log_smax(self, p):

@@ -21,7 +21,6 @@ import numpy as np
 
 
 MIN_DECORATED = 120  # frame height below which the map fills the frame, without axes or legend
-AXES = ("theta1", "theta2")  # the preset keys along x and y
 RANGE = (-math.pi, math.pi)
 
 

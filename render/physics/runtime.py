@@ -19,13 +19,16 @@ _generation = 0  # how many times Taichi was (re)initialised: fields of an older
 launched: list[str] = []  # kernel names in first-launch order, since the last init
 
 
-def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None) -> str:
-    """(Re)initialise Taichi if the settings differ; returns the arch actually in use."""
+def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, keep_log: bool = False) -> str:
+    """(Re)initialise Taichi if the settings differ; returns the arch actually in use. The log of kernels and
+    fields starts afresh, unless keep_log and Taichi runs on as it was. Called by render/physics/stepper.py's
+    Run, which builds the system it is for: no caller has to start Taichi, or in which precision."""
     global _current, _generation
     want = (arch, precision, threads)
     if _current is not None and _current[0] == want:
-        launched.clear()
-        allocated.clear()
+        if not keep_log:
+            launched.clear()
+            allocated.clear()
         return _current[1]
     # fast_math off: IEEE arithmetic, so no compiler may reassociate a float expression, and what it may do
     # depends on the CPU it targets. With it on, AVX-512 code generation folded sincos's exact range reduction

@@ -3,8 +3,8 @@ kernels, the drawing contract and the watchdog.
 
 A system module (render/physics/systems/) subclasses System, declares what the registry and the scene loader need as
 class attributes, and writes its physics once as Taichi functions:
-- accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group of LANES), so the
-  same code runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
+- accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group), so the same code
+  runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
 - energy(q, v) and points(q) for one pendulum's vectors.
 The integrators (render/physics/integrators.py) call force(); the canvas reads only points() and the Python-side
 contract (LINKS, bob_sizes(), reach(), lengths).
@@ -41,7 +41,6 @@ class System(runtime.Launcher):
     ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
     ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
     ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
-    LANES = 1  # pendulums per lane matrix (the columns integrators.step sees)
     CHUNK = 16  # pendulums per group of the advance kernel in f64; f32 takes twice as many (see advance)
 
     @classmethod
@@ -161,7 +160,7 @@ class System(runtime.Launcher):
     # --------------------------------------------------------------- per-system parts (Taichi)
     @ti.func
     def accel(self, q, v):
-        """Accelerations for lane matrices q, v (D × LANES)."""
+        """Accelerations for lane matrices q, v (D × pendulums)."""
         raise NotImplementedError
 
     @ti.func
@@ -253,8 +252,7 @@ class System(runtime.Launcher):
                 i = g * B + lane
                 if i < self.n:
                     self.q[i], self.v[i] = Q[:, lane], V[:, lane]
-                    if not (ti.abs(Q[:, lane]).max() < 1e30 and ti.abs(V[:, lane]).max() < 1e30):  # also NaN
-                        ti.atomic_min(self.bad[None], i)
+                    self.watch(i, Q[:, lane], V[:, lane])
 
     @ti.kernel
     def advance_libm(self, substeps: ti.i32, h: float):
@@ -271,8 +269,14 @@ class System(runtime.Launcher):
                 if ti.static(self.poincare):
                     poincare.detect(self, i, s, q0, v0, q, v, h)
             self.q[i], self.v[i] = q[:, 0], v[:, 0]
-            if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
-                ti.atomic_min(self.bad[None], i)
+            self.watch(i, q, v)
+
+    @ti.func
+    def watch(self, i, q, v):
+        """The watchdog's kernel side, after every advance: pendulum i's new state is NaN/inf (or beyond 1e30),
+        flagged by the least such index (the host side: check)."""
+        if not (ti.abs(q).max() < 1e30 and ti.abs(v).max() < 1e30):  # also NaN
+            ti.atomic_min(self.bad[None], i)
 
     @ti.kernel
     def energies(self, first: ti.i32):
@@ -297,11 +301,7 @@ class System(runtime.Launcher):
         """Energy scale for pendulums whose own energy is near zero."""
         return 1e-3 * sum(self.masses) * max(self.g, 1.0) * sum(self.lengths)
 
-    # --------------------------------------------------------------- host side
-    def advance_frame(self):
-        self.launch(f"{self.NAME}_advance", self.substeps)
-        self.t += self.substeps * self.h
-
+    # --------------------------------------------------------------- host side (for render/physics/stepper.py)
     def measure_energy(self, first: bool = False):
         """Energies at this frame into self.e, and the max relative drift so far into self.drift."""
         if first:
@@ -309,10 +309,11 @@ class System(runtime.Launcher):
         self.launch(f"{self.NAME}_energy", int(first))
 
     def check(self, frame: int, max_drift: float | None):
-        """Watchdog, once per frame: NaN/inf anywhere, or energy drift beyond the tolerance."""
+        """Watchdog, once per frame: NaN/inf anywhere, or energy drift beyond the tolerance. A blown-up pendulum
+        is named by its index in the scene (a subset's too: the certificate's run)."""
         bad = int(self.bad[None])
         if bad < self.n:
-            raise self.blew_up(frame, self.t, bad, "NaN/inf")
+            raise self.blew_up(frame, self.t, self.index(bad), "NaN/inf")
         if max_drift is not None and self.scene.has("energy"):
             drift = float(self.drift[None])
             if drift > max_drift:
@@ -325,6 +326,10 @@ class System(runtime.Launcher):
                     f"{100 * d[worst]:+.3g} % ({'gained' if d[worst] > 0 else 'lost'}) exceeds integrator.max_drift "
                     f"= {max_drift:g} ({self.method}, dt={self.h:.3g} s); try a smaller integrator.dt, "
                     f"--quality high, or a symplectic method")
+
+    def index(self, i: int) -> int:
+        """The scene's index of this system's pendulum i."""
+        return i if self.subset is None else int(self.subset[i])
 
     def blew_up(self, frame: int, t: float, pendulum: int, what: str) -> SimulationError:
         """The error of a run that blew up (the watchdog's, or the certificate's run: render/trust/certify.py)."""

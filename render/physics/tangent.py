@@ -1,7 +1,7 @@
 """The tangent map of one frame of a system's numerical flow, exact, in canonical coordinates.
 
     flow = TangentFlow(sim)          # sim: an allocated System (its q, v are the state at the frame's start)
-    images = flow.frame(basis)       # basis (n, 2D, k) -> DΦ·basis, before sim.advance_frame()
+    images = flow.frame(basis)       # basis (n, 2D, k) -> DΦ·basis, before the frame loop steps sim
 
 What is differentiated: one frame of the scene's own integrator (integrators.step, `substeps` steps of h)
 over the system's own force, wrapped in canonical coordinates:

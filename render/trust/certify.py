@@ -24,7 +24,8 @@ import time
 
 import numpy as np
 
-from ..physics import integrators, registry, runtime
+from ..physics import integrators, registry
+from ..physics.stepper import Run
 from ..errors import SimulationError
 
 SUBSAMPLE = 128  # pendulums certified; every one of them when a scene has no more
@@ -105,20 +106,20 @@ def shadow_scene(scene, h: float):
 
 def trajectory(scene, indices: np.ndarray, arch: str, threads=None, frames: int | None = None):
     """The states (frames, len(indices), D) of those pendulums at every frame time (the first `frames`
-    frames, or all), in float64; and the system that ran them."""
-    runtime.init(arch, scene.integrator.precision, threads)
-    sim = registry.get(scene.system)(scene, subset=indices)
+    frames, or all), in float64, a blow-up among them as NaN/inf; and the system that ran them."""
+    run = Run(scene, arch, threads, subset=indices)
     frames = scene.frames if frames is None else min(frames, scene.frames)
-    return record(sim, frames, sim.substeps, sim.h), sim
+    return record(run, frames), run.sim
 
 
-def record(sim, frames: int, substeps: int, h: float) -> np.ndarray:
-    """From the initial state, `substeps` steps of h per frame: the states at every frame time, in float64."""
-    out = np.empty((frames, sim.n, sim.D))
-    for f in range(frames):
-        if f:
-            sim.advance_by(substeps, h)
-        out[f] = sim.q.to_numpy()
+def record(run: Run, frames: int, substeps: int | None = None, h: float | None = None,
+           watch: bool = False) -> np.ndarray:
+    """From the state it stands in, `substeps` steps of h per frame (default: the scene's): the states at
+    every frame time, in float64. watch: the NaN watchdog raises on a blow-up (the certified run's); without,
+    a blow-up is a result. No energy is measured: the render's own run watches it."""
+    out = np.empty((frames, run.sim.n, run.sim.D))
+    for f in run.frames(frames, substeps=substeps, h=h, energy=False, watch=watch):
+        out[f] = run.sim.q.to_numpy()
     return out
 
 
@@ -139,15 +140,13 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
     if shadow_first:
         plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)  # the step only
         ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads)
-    main, sim = trajectory(scene, indices, arch, threads)
-    broken = ~(np.abs(main) < 1e30).all(-1)  # (frames, pendulums): NaN/inf, as the advance kernel flags them
-    if broken.any():  # a blow-up, not an untrue run: say so
-        frame, i = np.argwhere(broken)[0]
-        raise sim.blew_up(int(frame), frame / scene.video.fps, int(indices[i]), "NaN/inf")
+    run = Run(scene, arch, threads, subset=indices)
+    main = record(run, scene.frames, watch=True)  # a blow-up, not an untrue run: the watchdog says so
+    sim = run.sim
     shadow = shadow_scene(scene, sim.h)
     if not shadow_first and shadow.integrator.method == scene.integrator.method:
         sim.restart()  # the same method in f64 at a quarter of the step: the same compiled kernel
-        ref = record(sim, scene.frames, 4 * sim.substeps, sim.h / 4)
+        ref = record(run, scene.frames, 4 * sim.substeps, sim.h / 4)
     elif not shadow_first:
         ref, _ = trajectory(shadow, indices, arch, threads)
     tol = scene.integrator.tolerance

@@ -38,7 +38,8 @@ import time
 import numpy as np
 
 from . import certify
-from ..physics import grid, registry, runtime
+from ..physics import grid, registry
+from ..physics.stepper import Run
 from ..errors import SceneError, SimulationError
 from ..physics.tangent import TangentFlow, check_method
 
@@ -105,27 +106,27 @@ def spectrum(scene, indices: np.ndarray, arch: str = "cpu", threads=None, progre
     """Per pendulum, the running estimates (frames, 2D) of the spectrum, in f64 with the scene's integrator;
     and the per-frame log growths ln |R_ii|. Returns {"t": (F,), "running": (F, n, 2D), "logs": ...}."""
     s64 = scene.replace(integrator={"precision": "f64"})
-    runtime.init(arch, "f64", threads)
-    sim = registry.get(s64.system)(s64, subset=indices)
+    run = Run(s64, arch, threads, subset=indices)
+    sim = run.sim
     flow = TangentFlow(sim)
     dim = 2 * sim.D
     basis = np.tile(np.eye(dim), (sim.n, 1, 1))  # the initial basis: the canonical axes
     frames = scene.frames - 1
     logs = np.empty((frames, sim.n, dim))
     t0 = time.perf_counter()
-    for f in range(frames):
-        images = flow.frame(basis)
-        sim.advance_frame()
-        sim.check(f + 1, None)
-        basis, r = np.linalg.qr(images)
-        logs[f] = np.log(np.abs(np.diagonal(r, axis1=1, axis2=2)))
-        if not np.isfinite(logs[f]).all():
-            bad = int(np.nonzero(~np.isfinite(logs[f]).all(1))[0][0])
-            raise SimulationError(f"{scene.name}: frame {f + 1} (t={sim.t:.4g} s): pendulum {indices[bad]}: the "
-                                  f"tangent vectors became degenerate or not finite")
-        if progress and (f % 60 == 0 or f == frames - 1):
-            sys.stderr.write(f"\rlyapunov {100 * (f + 1) / frames:3.0f}%  {time.perf_counter() - t0:5.1f}s")
-            sys.stderr.flush()
+    for f in run.frames(energy=False):  # the NaN watchdog on
+        if f:  # the images of the frame just stepped
+            basis, r = np.linalg.qr(images)
+            logs[f - 1] = np.log(np.abs(np.diagonal(r, axis1=1, axis2=2)))
+            if not np.isfinite(logs[f - 1]).all():
+                bad = int(np.nonzero(~np.isfinite(logs[f - 1]).all(1))[0][0])
+                raise SimulationError(f"{scene.name}: frame {f} (t={sim.t:.4g} s): pendulum {indices[bad]}: the "
+                                      f"tangent vectors became degenerate or not finite")
+            if progress and ((f - 1) % 60 == 0 or f == frames):
+                sys.stderr.write(f"\rlyapunov {100 * f / frames:3.0f}%  {time.perf_counter() - t0:5.1f}s")
+                sys.stderr.flush()
+        if f < frames:
+            images = flow.frame(basis)  # DΦ of the frame ahead, from the state before the step
     if progress:
         sys.stderr.write("\n")
     frame_dt = sim.substeps * sim.h

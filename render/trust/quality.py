@@ -18,7 +18,8 @@ import numpy as np
 
 from . import certify
 from .levels import LEVELS  # noqa: F401 - quality.LEVELS, the levels this module meets
-from ..physics import integrators, registry, runtime
+from ..physics import integrators, registry
+from ..physics.stepper import Run
 from ..errors import SceneError
 
 TARGET = {"draft": 0.5, "standard": 0.75, "high": 1.0}  # of the duration, for the median pendulum
@@ -120,24 +121,26 @@ class Pilot:
         # As far as the target needs: a pilot's outcome is known there.
         self.frames = min(scene.frames, math.ceil(need * scene.video.fps) + 2)
         self.ref, _ = certify.trajectory(ref, self.indices, arch, threads, self.frames)
-        self.systems = {}
+        self.runs = {}
 
     def median_until(self, s: dict, need: float) -> float:
         """The median pendulum's faithful time under setting s, run only as far as it takes to know."""
         scene = _with(self.scene, s)
-        runtime.init(self.arch, s["precision"], self.threads)
         key = (s["method"], s["precision"])
-        if key not in self.systems or self.systems[key][0] != runtime.generation():  # one compile per method
-            self.systems[key] = (runtime.generation(), registry.get(scene.system)(scene, subset=self.indices))
-        sim = self.systems[key][1]
+        if key not in self.runs or not self.runs[key].current:  # one compile per method and runtime
+            self.runs[key] = Run(scene, self.arch, self.threads, subset=self.indices)
+        run = self.runs[key]
+        sim = run.sim
         sim.restart()
         fps, tol = scene.video.fps, scene.integrator.tolerance
         substeps = math.ceil(1.0 / (fps * s["dt"]) - 1e-9)
         h = 1.0 / (fps * substeps)
         until = np.full(len(self.indices), scene.video.duration)
         half = len(self.indices) // 2
-        for f in range(1, self.frames):
-            sim.advance_by(substeps, h)
+        # No watchdog: a blow-up is an outcome here (NaN is broken), not an error.
+        for f in run.frames(self.frames, substeps=substeps, h=h, energy=False, watch=False):
+            if not f:
+                continue  # the start, where every setting agrees
             err = certify.MARGIN * sim.deviation(sim.q.to_numpy(), self.ref[f]) / tol
             fresh = (until >= scene.video.duration) & ~(err <= 1.0)  # NaN counts as broken
             until[fresh] = (f - 1) / fps

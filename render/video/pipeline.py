@@ -12,15 +12,10 @@ import numpy as np
 
 from . import audio
 from ..trust import certify, quality
-from ..physics import grid, registry, runtime
+from ..physics import grid, runtime
+from ..physics.stepper import Run
 from .atomic import digest, replacing, write_atomic
-from ..physics.system import DEFAULT_MAX_DRIFT
 from .version import __version__
-
-
-def make_system(scene, subset=None):
-    """The scene's system, built by the class the registry holds for it."""
-    return registry.get(scene.system)(scene, subset)
 
 
 def prepare(scene, arch: str, threads: int | None):
@@ -32,7 +27,7 @@ def prepare(scene, arch: str, threads: int | None):
     # A map certifies the lattice its trust mask is read from (render/physics/grid.py), not 128 pixels in row order.
     cert = certify.certify(scene, arch, threads, grid.trust_indices(scene) if scene.fractal else None)
     timings = {"quality": t_quality, "certify": cert.cost_s} if scene.quality else {"certify": cert.cost_s}
-    if scene.has("lyapunov"):  # before the render's own runtime.init: the spectrum runs in f64
+    if scene.has("lyapunov"):  # before the render's own Run starts its precision: the spectrum runs in f64
         from ..trust import lyapunov
         t = time.perf_counter()
         cert = dataclasses.replace(cert, lyapunov=lyapunov.for_certificate(scene, cert, arch, threads))
@@ -44,22 +39,6 @@ def progress_bar(total: int, desc: str, enabled: bool):
     from tqdm import tqdm
     return tqdm(total=total, desc=desc, unit="frame", file=sys.stderr, disable=not enabled, leave=False,
                 dynamic_ncols=True)
-
-
-def frames(scene, sim, timings: dict, advance=None):
-    """Yield each frame index with the simulation at that frame's time (frame 0 is t=0), watchdog checked.
-    `advance` moves it one frame on (default: sim.advance_frame; a map stops pixels at their events)."""
-    advance = advance or sim.advance_frame
-    max_drift = scene.integrator.max_drift or DEFAULT_MAX_DRIFT
-    for f in range(scene.frames):
-        t = time.perf_counter()
-        if f:
-            advance()
-        if scene.has("energy"):
-            sim.measure_energy(first=f == 0)
-        sim.check(f, max_drift)
-        timings["simulate"] += time.perf_counter() - t
-        yield f
 
 
 @contextmanager
@@ -87,8 +66,8 @@ class Source:
 
     def __init__(self, scene, arch: str = "cpu", threads: int | None = None):
         self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
-        self.arch = runtime.init(arch, self.scene.integrator.precision, threads)
-        self.sim = make_system(self.scene)
+        self.run = Run(self.scene, arch, threads)
+        self.arch, self.sim = self.run.arch, self.run.sim
         if self.scene.fractal:
             if self.scene.fractal == "lyapunov":
                 from ..maps.ftle import FtleMap as Map  # it carries each pixel's tangent vectors through the frame
@@ -107,8 +86,8 @@ class Source:
         if rewind:
             self.sim.restart()
             self.canvas.restart()
-        self._steps = frames(self.scene, self.sim, self.timings,  # frame 0 measures the energy afresh
-                             getattr(self.canvas, "advance_frame", None))
+        self._steps = self.run.frames(advance=getattr(self.canvas, "advance", None),  # a map's own advance
+                                      timings=self.timings)  # frame 0 measures the energy afresh
         self.index = -1
 
     def next_frame(self, out: np.ndarray | None = None) -> np.ndarray:
@@ -129,12 +108,12 @@ def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
     first one compiles or loads the kernel), and what metadata reports of the run: `integrator`, `energy`,
     `kernels`, `fields`."""
     scene, chosen, cert, timings = prepare(scene, arch, threads)
-    runtime.init(arch, scene.integrator.precision, threads)
-    sim = make_system(scene)
+    run = Run(scene, arch, threads)
+    sim = run.sim
     timings["simulate"] = 0.0
     q = np.empty((scene.frames, sim.n, sim.D))
     warm = 0.0
-    for f in frames(scene, sim, timings):
+    for f in run.frames(timings=timings):
         q[f] = sim.q.to_numpy()
         if f == 1:
             warm = timings["simulate"]
@@ -209,12 +188,12 @@ def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = F
     if not scene.has("energy"):
         scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
     scene, chosen, cert, before = prepare(scene, arch, None)
-    runtime.init(arch, scene.integrator.precision)
-    sim = make_system(scene)
+    run = Run(scene, arch)
+    sim = run.sim
     timings = {**before, "simulate": 0.0}
     rows: dict[str, list] = {"t": [], "energy": []}
     with progress_bar(scene.frames, scene.name, progress) as bar:
-        for f in frames(scene, sim, timings):
+        for f in run.frames(timings=timings):
             rows["t"].append(f / scene.video.fps)
             rows["energy"].append(sim.e.to_numpy())
             for k, v in sim.state().items():

@@ -1,0 +1,73 @@
+"""The frame loop (render/physics/stepper.py): Taichi started by the run that needs it, frames at their times
+against DOP853, the watchdog on the certified run and off where a blow-up is a measurement."""
+import numpy as np
+import pytest
+import taichi as ti
+
+from conftest import make_scene
+from render.errors import SimulationError
+from render.physics import reference, runtime
+from render.physics.stepper import Run
+from render.trust import certify
+
+PEND = {"theta1": 2.0, "theta2": 2.6, "spread": 0.2}
+# A stiff spring (ω ≈ 1000/s) at a step 7x past RK4's stability limit (hω < 2.8): it grows ~1e4x a step.
+BLOWS_UP = {"pendulums": {"theta1": 1.0, "theta2": 1.5, "spread": 0.2, "stiffness": 1e6},
+            "integrator": {"method": "rk4", "dt": 0.02, "allow_unstable": True, "min_faithful": 0.0},
+            "video": {"fps": 10, "duration": 2.0}}
+
+
+def test_a_run_starts_taichi_in_its_scenes_precision_and_a_stale_one_says_so():
+    r64 = Run(make_scene("rigid", 3, pendulums=PEND, video={"fps": 10, "duration": 0.3}))
+    again = Run(make_scene("rigid", 2, pendulums=PEND, video={"fps": 10, "duration": 0.3}))
+    assert again.generation == r64.generation and r64.current  # the same settings: no restart
+    assert runtime.real() == ti.f64 and r64.sim.q.to_numpy().dtype == np.float64
+    r32 = Run(make_scene("rigid", 3, pendulums=PEND, video={"fps": 10, "duration": 0.3},
+                         integrator={"precision": "f32"}))
+    assert runtime.real() == ti.f32 and r32.sim.q.to_numpy().dtype == np.float32
+    assert r32.current and not r64.current
+    with pytest.raises(RuntimeError, match="restarted since this run was built"):
+        next(r64.frames())
+    assert list(r32.frames()) == [0, 1, 2]
+
+
+def test_a_run_may_hold_its_scene_in_another_precision_and_add_to_the_log():
+    """What a comparison's drawing pass needs: f32 variants' states held in f64, every panel in one log."""
+    s32 = make_scene("rigid", 3, pendulums=PEND, video={"fps": 10, "duration": 0.3}, integrator={"precision": "f32"})
+    a = Run(s32, precision="f64")
+    assert runtime.real() == ti.f64 and a.sim.q.to_numpy().dtype == np.float64
+    one = dict(runtime.allocated)
+    b = Run(s32, precision="f64", keep_log=True)
+    assert b.generation == a.generation and runtime.allocated["state.q"] == 2 * one["state.q"]
+    Run(s32, precision="f64")
+    assert runtime.allocated == one  # afresh
+
+
+def test_every_frame_is_at_its_time_and_on_the_dop853_trajectory():
+    scene = make_scene("rigid", 4, pendulums=PEND, video={"fps": 20, "duration": 0.5}, effects=["energy"])
+    run = Run(scene)
+    times = np.arange(scene.frames) / scene.video.fps
+    q0, v0 = reference.initial_state(scene)
+    truth, _ = reference.solve(scene, (q0, v0), times[-1], t_eval=times, rtol=1e-12, atol=1e-12)
+    timings = {"simulate": 0.0}
+    seen = []
+    for f in run.frames(timings=timings):
+        assert run.sim.t == pytest.approx(times[f], abs=1e-12)
+        np.testing.assert_allclose(run.sim.q.to_numpy(), truth[f], rtol=0, atol=1e-8)
+        seen.append(f)
+    assert seen == list(range(scene.frames)) and timings["simulate"] > 0
+    assert 0 < run.sim.drift[None] < 1e-9  # the energy was measured every frame, frame 0 the reference
+
+
+def test_the_certified_run_has_the_watchdog_and_names_the_scenes_pendulum():
+    scene = make_scene("elastic", 8, **BLOWS_UP)
+    with pytest.raises(SimulationError, match=r"blew up at t=.*\(pendulum 2: NaN/inf") as e:
+        certify.certify(scene, indices=np.array([2, 5]))  # subset index 0 is the scene's pendulum 2
+    assert "frame " in str(e.value) and "frame 0" not in str(e.value)
+
+
+def test_where_the_watchdog_is_off_a_blow_up_is_a_result():
+    """The pilots and the measurements (quality.py, flagship.py) read a blow-up as a broken run."""
+    scene = make_scene("elastic", 8, **BLOWS_UP)
+    q, _ = certify.trajectory(scene, np.array([2, 5]), "cpu")
+    assert q.shape[0] == scene.frames and np.isfinite(q[0]).all() and not np.isfinite(q[-1]).all()
