@@ -16,7 +16,8 @@ PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_preci
 
 def test_accuracy_quick_writes_tables_and_charts(tmp_path):
     out = tmp_path / "acc"
-    r = run_cli("accuracy", "--quick", "--out", out, timeout=240)
+    # the timeout is a safety net, not a speed check: --quick takes 3 min quiet and over 7 on a loaded machine
+    r = run_cli("accuracy", "--quick", "--out", out, timeout=900)
     assert r.returncode == 0, r.stderr
     assert "accuracy [" in r.stderr  # progress on stderr
     assert sorted(p.name for p in out.iterdir()) == sorted([*PNGS, "accuracy.csv", "accuracy.md", "quality.md",
