@@ -11,19 +11,18 @@ them). The pipes are enlarged so a writer hands over a frame in a few system cal
 from __future__ import annotations
 
 import errno
-import math
 import os
 import queue
 import subprocess
 import tempfile
 import threading
 import time
-from fractions import Fraction
 from pathlib import Path
 
 import imageio_ffmpeg
 import numpy as np
 
+from . import gif
 from .atomic import publish, temp_beside
 from ..errors import EncodeError
 
@@ -59,31 +58,10 @@ def mp4_args(video) -> list[str]:
 
 
 def gif_args(video) -> list[str]:
-    width = min(video.gif_width, video.width)  # downscale only: a small video keeps its own size
-    graph = (f"scale={width}:-2:flags=area,split[a][b];"
-             f"[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
+    """The GIF's frames arrive at its own size (render/video/gif.py): only the palette is made here."""
+    graph = (f"split[a][b];[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
              f"[b][p]paletteuse=dither=bayer:bayer_scale=3")
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
-
-
-def gif_rate(video) -> int:
-    return min(video.gif_fps, video.fps)
-
-
-def _near(x: Fraction) -> int:
-    return math.floor(x + Fraction(1, 2))  # ffmpeg's AV_ROUND_NEAR_INF, for x >= 0
-
-
-def gif_repeats(video, frames: int) -> list[int]:
-    """How many GIF frames each video frame becomes (mostly 0 or 1): the GIF's frames are picked here and only
-    those are piped, instead of every frame for ffmpeg's fps filter to drop (2/3 of the pipe at 60 -> 20 fps).
-    The picks are that filter's (eof_action=pass): GIF frame k shows the last video frame whose time, rounded
-    to the GIF's clock, is at most k, for k < ceil(frames·gif/fps); so the GIF is byte-identical to the one the
-    filter made (checked against ffmpeg for 585 rate and length pairs: tests/test_render.py)."""
-    r = Fraction(gif_rate(video), video.fps)
-    slots = math.ceil(frames * r)
-    starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
-    return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
 
 
 ARGS = {"mp4": mp4_args, "gif": gif_args}
@@ -117,9 +95,11 @@ class _Still:
 class _Target:
     """One ffmpeg process, the thread that feeds it, and where its output goes."""
 
-    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None):
+    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None,
+                 small: tuple[int, int] | None = None):
         self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
         self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
+        self.small = small  # the GIF's (width, height): it is fed frames of that size only
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
         self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
@@ -155,6 +135,7 @@ class Encoder:
         self.targets: list[_Target] = []
         self.written = 0
         self.stills: list[_Still] = []
+        self.size = (video.width, video.height)
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         try:
             for fmt in formats or video.formats:
@@ -164,9 +145,9 @@ class Encoder:
                     continue
                 tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
-                rate = gif_rate(video) if fmt == "gif" else video.fps
+                rate, (w, h) = (gif.rate(video), gif.size(video)) if fmt == "gif" else (video.fps, self.size)
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
-                       "-s", f"{video.width}x{video.height}", "-r", str(rate), "-i", "-", "-an",
+                       "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-an",
                        *ARGS[fmt](video), tmp]
                 try:
                     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
@@ -175,8 +156,8 @@ class Encoder:
                     tmp.unlink(missing_ok=True)
                     log.close()
                     raise
-                self.targets.append(_Target(final, tmp, proc, log,
-                                            gif_repeats(video, frames) if fmt == "gif" else None))
+                self.targets.append(_Target(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif"
+                                            else None, gif.size(video) if fmt == "gif" else None))
         except BaseException:
             self.abort()
             raise
@@ -195,10 +176,12 @@ class Encoder:
         else:
             self.abort()
 
-    def write(self, frame: np.ndarray):
-        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind.
+    def write(self, frame: np.ndarray, small: np.ndarray | None = None):
+        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind. `small` is the
+        GIF's frame for it, drawn at the GIF's size (render/video/gif.py), where the GIF keeps this frame;
+        without it the GIF gets `frame` area-averaged to its size. No frame larger reaches the GIF's pipe.
 
-        The frame is shared, not copied: do not modify it after writing it.
+        The frames are shared, not copied: do not modify them after writing them.
         """
         for t in self.targets:
             if t.error is not None:
@@ -208,8 +191,13 @@ class Encoder:
                     pass
                 raise self._failure("stopped", t.error)
         for t in self.targets:
-            for _ in range(1 if t.repeats is None else t.repeats[self.written]):
-                t.queue.put(frame)
+            n = 1 if t.repeats is None else t.repeats[self.written]
+            if n and t.small is not None:
+                mine = gif.shrink(frame, *t.small) if small is None else small
+                if mine.shape != (t.small[1], t.small[0], 3):
+                    raise ValueError(f"a GIF frame of {mine.shape[1]}x{mine.shape[0]}, not {t.small[0]}x{t.small[1]}")
+            for _ in range(n):
+                t.queue.put(frame if t.small is None else mine)
         self.written += 1
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept
