@@ -16,7 +16,7 @@ EXE = imageio_ffmpeg.get_ffmpeg_exe()
 
 def video(fps, gif_fps=20, width=64, height=36, gif_width=32):
     return types.SimpleNamespace(fps=fps, gif_fps=gif_fps, width=width, height=height, gif_width=gif_width,
-                                 formats=("gif",))
+                                 formats=("gif",), palette="fan")
 
 
 def fps_filter_picks(fps: int, gif_fps: int, frames: int) -> list[int]:

@@ -37,30 +37,48 @@ F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call
 
 
 # Chosen on rigid_chaos (20 s, 1280x720, 60 fps), every setting encoding the same raw frames:
-# - MP4: veryfast at crf 31 is 11.5 MB (crf 20 was 36 MB); crf is the only lever that matters here. Near that
+# - MP4: veryfast at crf 31 was 11.96 MB (crf 20 was 36 MB); crf is the lever for the picture. Near that
 #   size "fast" gains 0.2-0.4 dB PSNR but made the whole render 2x slower on 2 cores (the render waits on
 #   the encoder); "medium" costs 2x "veryfast" for 0.4 dB. tune=animation, aq-mode=3, weightp=2, a longer
-#   GOP and smaller deadzones did not beat plain crf at equal size.
-# - GIF: the trails fade every frame, so nearly every lit pixel changes in every frame and dithering is not
-#   what makes the file big; pixels x frames x palette size is. 352 px (area-averaged: no lanczos ringing
-#   around thin lines) x 20 fps x 64 colours makes 4.6 MB (480 px x 25 fps x 256 colours was 14.7 MB) and
-#   a third of the CPU. Bayer dithering costs nothing here and keeps the fractal's gradients from banding.
-MP4_PRESET, MP4_CRF = "veryfast", "31"
-GIF_COLOURS = 64
+#   GOP and smaller deadzones did not beat plain crf at equal size. But crf 31 ghosts the HUD's digits (the
+#   last clock's strokes linger in P-frames): the columns beside the pendulums' circle, where the HUD and a
+#   map's axes live (render/draw/hud.py), get a finer quantiser (x264's regions of interest, ffmpeg's addroi,
+#   qoffset ROI_QOFFSET) and the rest crf 32. On the first 8 s: the same bytes (1.31 vs 1.30 MB), the HUD's
+#   corners 38.8 dB instead of 33.3, the whole frame 30.18 dB instead of 30.22.
+# - GIF: its frames come drawn at its own size (render/video/gif.py). The trails fade every frame, so nearly
+#   every lit pixel changes in every frame and dithering is not what makes the file big; pixels x frames x
+#   palette size is. 352 px x 20 fps x 64 colours makes about 4.6 MB (480 px x 25 fps x 256 colours was
+#   14.7 MB). Bayer dithering costs nothing here and keeps the fractal's gradients from banding. A rainbow
+#   (video.palette) is the exception: 64 colours for the whole GIF keep a few greens and purples of the hue
+#   circle, so it gets 256 colours chosen for each frame (stats_mode=single, new=1): its hues' distance to
+#   the frames it was given falls from 7.5° to 0.7° (tests/test_gif.py's measure), for 2.2x the bytes.
+MP4_PRESET, MP4_CRF, ROI_QOFFSET = "veryfast", "32", -0.3
+GIF_COLOURS, RAINBOW_COLOURS = 64, 256
+REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
 # at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its 11.5 MB of picture.
 AUDIO_CODEC, AUDIO_RATE, AUDIO_KBPS = "aac", 48_000, 128
 
 
+def roi(video) -> list[str]:
+    """The columns left and right of the pendulums' circle, a finer quantiser there: the HUD's text reads."""
+    side = (video.width - 2 * REACH * video.height) / 2 / video.width
+    if side < 0.02:
+        return []
+    x, q = f"{side:.4f}", ROI_QOFFSET
+    return ["-vf", f"addroi=0:0:iw*{x}:ih:{q},addroi=iw*(1-{x}):0:iw*{x}:ih:{q}"]
+
+
 def mp4_args(video) -> list[str]:
-    return ["-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
+    return [*roi(video), "-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
             "-movflags", "+faststart", "-f", "mp4"]
 
 
 def gif_args(video) -> list[str]:
     """The GIF's frames arrive at its own size (render/video/gif.py): only the palette is made here."""
-    graph = (f"split[a][b];[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
-             f"[b][p]paletteuse=dither=bayer:bayer_scale=3")
+    make, use = (f"stats_mode=single:max_colors={RAINBOW_COLOURS}", "new=1:") if video.palette == "rainbow" else \
+        (f"stats_mode=diff:max_colors={GIF_COLOURS}", "")
+    graph = f"split[a][b];[a]palettegen={make}[p];[b][p]paletteuse={use}dither=bayer:bayer_scale=3"
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
 
 
