@@ -47,13 +47,15 @@ F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call
 #   corners 38.8 dB instead of 33.3, the whole frame 30.18 dB instead of 30.22.
 # - GIF: its frames come drawn at its own size (render/video/gif.py). The trails fade every frame, so nearly
 #   every lit pixel changes in every frame and dithering is not what makes the file big; pixels x frames x
-#   palette size is. 352 px x 20 fps x 64 colours makes about 4.6 MB (480 px x 25 fps x 256 colours was
-#   14.7 MB). Bayer dithering costs nothing here and keeps the fractal's gradients from banding. A rainbow
-#   (video.palette) is the exception: 64 colours for the whole GIF keep a few greens and purples of the hue
-#   circle, so it gets 256 colours chosen for each frame (stats_mode=single, new=1): its hues' distance to
-#   the frames it was given falls from 7.5° to 0.7° (tests/test_gif.py's measure), for 2.2x the bytes.
+#   palette size is. 352 px x 20 fps x 48 colours makes 4.69 MB (64 colours made 5.11 MB of the drawn frames,
+#   4.77 MB of the area-averaged ones, whose thin lines and text were smeared into fewer distinct pixels; 480 px
+#   x 25 fps x 256 colours was 14.7 MB); 48 colours cost the clock's corner 0.2 dB. Bayer dithering costs
+#   nothing here and keeps the fractal's gradients from banding. A rainbow (video.palette) is the exception:
+#   one small palette for the whole GIF keeps a few greens and purples of the hue circle, so it gets 256
+#   colours chosen for each frame (stats_mode=single, new=1): on rainbow_1000 (6 s) its hues' distance to the
+#   frames it was given falls from 0.36 to 0.03 (tests/test_gif.py's measure), for 2.2x the bytes.
 MP4_PRESET, MP4_CRF, ROI_QOFFSET = "veryfast", "32", -0.3
-GIF_COLOURS, RAINBOW_COLOURS = 64, 256
+GIF_COLOURS, RAINBOW_COLOURS = 48, 256
 REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
 # at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its 11.5 MB of picture.
