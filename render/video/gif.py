@@ -53,26 +53,25 @@ def repeats(video, frames: int) -> list[int]:
 
 def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
     """An H×W×3 uint8 frame area-averaged down to h×w: each pixel the mean of the area of the frame it covers,
-    partly covered pixels weighted by their share (what ffmpeg's flags=area does). Sums of integers in
-    float64 are exact and numpy's cumsum runs in order, so the bytes never depend on threads."""
+    partly covered pixels weighted by their share (what ffmpeg's flags=area does). numpy sums in order on
+    one thread, so the bytes never depend on the thread count. Rows first: that pass reads the whole frame,
+    and rows are contiguous."""
     if frame.shape[:2] == (h, w):
         return frame
-    x = _average(frame.astype(np.float64), w, axis=1)
-    return np.rint(_average(x, h, axis=0)).clip(0, 255).astype(np.uint8)
+    rows = _average(frame, h)
+    return np.rint(np.swapaxes(_average(np.swapaxes(rows, 0, 1), w), 0, 1)).clip(0, 255).astype(np.uint8)
 
 
-def _average(a: np.ndarray, m: int, axis: int) -> np.ndarray:
-    """a averaged down to m cells along `axis`, by differences of its running sum at the cells' edges."""
-    n = a.shape[axis]
-    run = np.cumsum(a, axis=axis)
-    run = np.concatenate([np.zeros_like(np.take(run, [0], axis=axis)), run], axis=axis)  # run[k]: first k
+def _average(a: np.ndarray, m: int) -> np.ndarray:
+    """a (n ≥ m cells along its first axis) averaged down to m: whole cells summed in integers (exact), the
+    cells an edge cuts shared by the fraction on each side."""
+    n = len(a)
     edges = np.arange(m + 1) * (n / m)
-    k = np.minimum(np.floor(edges).astype(np.int64), n - 1)
-    shape = [1] * a.ndim
-    shape[axis] = m + 1
-    frac = (edges - k).reshape(shape)
-    at = np.take(run, k, axis=axis) + frac * (np.take(run, k + 1, axis=axis) - np.take(run, k, axis=axis))
-    return np.diff(at, axis=axis) * (m / n)
+    k = np.floor(edges).astype(np.int64)  # strictly increasing, since n / m >= 1; k[m] = n
+    frac = (edges - k).reshape(-1, *[1] * (a.ndim - 1))
+    cut = np.take(a, np.minimum(k, n - 1), axis=0) * frac  # frac[m] = 0: nothing past the end
+    whole = np.add.reduceat(a, k[:-1], axis=0, dtype=np.int64 if a.dtype.kind in "ui" else np.float64)
+    return (whole + cut[1:] - cut[:-1]) * (m / n)
 
 
 def _stamp(canvas):
