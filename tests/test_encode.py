@@ -1,5 +1,7 @@
-"""render/video/encode.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps filter picked them."""
+"""render/video/encode.py and gif.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps filter picked
+them, and shrunk before it, exactly as an area average does."""
 import itertools
+import math
 import subprocess
 import types
 
@@ -7,14 +9,14 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 
-from render.video import encode
+from render.video import encode, gif
 
 EXE = imageio_ffmpeg.get_ffmpeg_exe()
 
 
 def video(fps, gif_fps=20, width=64, height=36, gif_width=32):
     return types.SimpleNamespace(fps=fps, gif_fps=gif_fps, width=width, height=height, gif_width=gif_width,
-                                 formats=("gif",))
+                                 formats=("gif",), palette="fan")
 
 
 def fps_filter_picks(fps: int, gif_fps: int, frames: int) -> list[int]:
@@ -31,14 +33,14 @@ def fps_filter_picks(fps: int, gif_fps: int, frames: int) -> list[int]:
                                          (100, 20), (120, 25), (25, 10)])
 def test_gif_picks_are_the_fps_filters(fps, gif_fps):
     for frames in (1, 2, 3, 4, 7, 31, 60, 61, 121):
-        repeats = encode.gif_repeats(video(fps, gif_fps), frames)
+        repeats = gif.repeats(video(fps, gif_fps), frames)
         mine = [i for i, n in enumerate(repeats) for _ in range(n)]
         assert mine == fps_filter_picks(fps, min(fps, gif_fps), frames), (fps, gif_fps, frames)
 
 
 def test_the_gif_is_byte_identical_to_the_one_the_fps_filter_made(tmp_path):
-    """Every frame through ffmpeg's fps filter (as before) and only the picked ones at the GIF's rate: the same
-    file, bit for bit, while the pipe carries a third of the frames."""
+    """Every frame (shrunk to the GIF's size) through ffmpeg's fps filter, and only the picked ones at the GIF's
+    rate, shrunk by the encoder: the same file, bit for bit, while the pipe carries a third of the frames."""
     v, n = video(60, 20, 96, 54, 48), 47
     rng = np.random.default_rng(5)
     frames = [rng.integers(0, 255, (54, 96, 3), dtype=np.uint8) for _ in range(n)]
@@ -48,8 +50,37 @@ def test_the_gif_is_byte_identical_to_the_one_the_fps_filter_made(tmp_path):
         enc.write(f)
     enc.close()
     graph = "fps=20:eof_action=pass," + encode.gif_args(v)[1]
-    cmd = [EXE, "-nostdin", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "96x54",
+    cmd = [EXE, "-nostdin", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "48x28",
            "-r", "60", "-i", "-", "-an", "-vf", graph, "-loop", "0", "-f", "gif", str(tmp_path / "filtered.gif")]
-    subprocess.run(cmd, input=b"".join(f.tobytes() for f in frames), check=True)
+    subprocess.run(cmd, input=b"".join(gif.shrink(f, 48, 28).tobytes() for f in frames), check=True)
     assert (tmp_path / "picked.gif").read_bytes() == (tmp_path / "filtered.gif").read_bytes()
     assert piped == 16 and piped == len(list(itertools.islice(frames, 0, n, 3)))
+
+
+def area_reference(frame: np.ndarray, w: int, h: int) -> np.ndarray:
+    """An area average written independently: each output pixel integrates the frame, upsampled by the least
+    common multiple of the sizes (so every output pixel covers whole sub-pixels), over its rectangle."""
+    H, W = frame.shape[:2]
+    ly, lx = math.lcm(H, h), math.lcm(W, w)
+    up = frame.astype(np.float64).repeat(ly // H, 0).repeat(lx // W, 1)
+    return up.reshape(h, ly // h, w, lx // w, 3).mean(axis=(1, 3))
+
+
+@pytest.mark.parametrize("size", [(96, 54, 48, 28), (128, 72, 35, 20), (64, 36, 64, 36), (50, 30, 7, 4)])
+def test_shrink_is_an_area_average(size):
+    W, H, w, h = size
+    frame = np.random.default_rng(7).integers(0, 256, (H, W, 3), dtype=np.uint8)
+    got = gif.shrink(frame, w, h)
+    assert got.shape == (h, w, 3) and got.dtype == np.uint8
+    assert np.abs(got.astype(np.float64) - area_reference(frame, w, h)).max() <= 0.5 + 1e-9  # rounding only
+    flat = np.full((H, W, 3), 200, np.uint8)
+    assert (gif.shrink(flat, w, h) == 200).all()  # a flat frame stays flat: the weights sum to one
+
+
+def test_a_gif_frame_of_the_wrong_size_is_refused(tmp_path):
+    v = video(20, 20, 96, 54, 48)
+    enc = encode.Encoder(tmp_path, "x", v, 2, formats=["gif"])
+    with pytest.raises(ValueError, match="48x28"):
+        enc.write(np.zeros((54, 96, 3), np.uint8), np.zeros((54, 96, 3), np.uint8))
+    enc.abort()
+    assert not list(tmp_path.iterdir())

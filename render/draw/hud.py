@@ -56,6 +56,7 @@ class Info:
     faithful_until_s: float | None = None  # the certificate (render/trust/certify.py), if there is one
     median_until_s: float | None = None
     panel: bool = False  # a split-screen panel (render/draw/split.py): its label already says method, step and error
+    one_line: bool = False  # under 360 px, still say the certificate, in one line (the GIF's HUD: render/video/gif.py)
 
     @classmethod
     def of(cls, scene, dt=None, cert=None, panel=False):
@@ -166,13 +167,15 @@ class Hud(runtime.Launcher):
     def certificate(self) -> list:
         """The top right block: until when all, and half, of the certified pendulums are faithful."""
         i = self.info
-        if not self.words or i.faithful_until_s is None:
+        if i.faithful_until_s is None or not (self.words or i.one_line):
             return []
         first, half = i.faithful_until_s >= self.duration, i.median_until_s >= self.duration
         lines = [("faithful to the end", WHITE)] if first else [
             (f"all faithful to {seconds(i.faithful_until_s)}", AMBER),
             ("half faithful to the end" if half else f"half faithful to {seconds(i.median_until_s)}",
              WHITE if half else RED)]
+        if not self.words:  # a GIF's small frame has room beside the pendulums for one short line
+            lines = [lines[0] if first else (f"faithful to {seconds(i.faithful_until_s)}", AMBER)]
         sh = self.cell(self.small, self.ss)[1]
         return [self.text(s, self.w - self.m, self.m + k * sh, c, ha="right") for k, (s, c) in enumerate(lines)]
 

@@ -11,19 +11,18 @@ them). The pipes are enlarged so a writer hands over a frame in a few system cal
 from __future__ import annotations
 
 import errno
-import math
 import os
 import queue
 import subprocess
 import tempfile
 import threading
 import time
-from fractions import Fraction
 from pathlib import Path
 
 import imageio_ffmpeg
 import numpy as np
 
+from . import gif
 from .atomic import publish, temp_beside
 from ..errors import EncodeError
 
@@ -38,52 +37,52 @@ F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call
 
 
 # Chosen on rigid_chaos (20 s, 1280x720, 60 fps), every setting encoding the same raw frames:
-# - MP4: veryfast at crf 31 is 11.5 MB (crf 20 was 36 MB); crf is the only lever that matters here. Near that
+# - MP4: veryfast at crf 31 was 11.96 MB (crf 20 was 36 MB); crf is the lever for the picture. Near that
 #   size "fast" gains 0.2-0.4 dB PSNR but made the whole render 2x slower on 2 cores (the render waits on
 #   the encoder); "medium" costs 2x "veryfast" for 0.4 dB. tune=animation, aq-mode=3, weightp=2, a longer
-#   GOP and smaller deadzones did not beat plain crf at equal size.
-# - GIF: the trails fade every frame, so nearly every lit pixel changes in every frame and dithering is not
-#   what makes the file big; pixels x frames x palette size is. 352 px (area-averaged: no lanczos ringing
-#   around thin lines) x 20 fps x 64 colours makes 4.6 MB (480 px x 25 fps x 256 colours was 14.7 MB) and
-#   a third of the CPU. Bayer dithering costs nothing here and keeps the fractal's gradients from banding.
-MP4_PRESET, MP4_CRF = "veryfast", "31"
-GIF_COLOURS = 64
+#   GOP and smaller deadzones did not beat plain crf at equal size. But crf 31 ghosts the HUD's digits (the
+#   last clock's strokes linger in P-frames): the columns beside the pendulums' circle, where the HUD and a
+#   map's axes live (render/draw/hud.py), get a finer quantiser (x264's regions of interest, ffmpeg's addroi,
+#   qoffset ROI_QOFFSET) and the rest crf 32. On the first 8 s: the same bytes (1.31 vs 1.30 MB), the HUD's
+#   corners 38.8 dB instead of 33.3, the whole frame 30.18 dB instead of 30.22.
+# - GIF: its frames come drawn at its own size (render/video/gif.py). The trails fade every frame, so nearly
+#   every lit pixel changes in every frame and dithering is not what makes the file big; pixels x frames x
+#   palette size is. 352 px x 20 fps x 48 colours makes 4.69 MB (64 colours made 5.11 MB of the drawn frames,
+#   4.77 MB of the area-averaged ones, whose thin lines and text were smeared into fewer distinct pixels; 480 px
+#   x 25 fps x 256 colours was 14.7 MB); 48 colours cost the clock's corner 0.2 dB. Bayer dithering costs
+#   nothing here and keeps the fractal's gradients from banding. A rainbow (video.palette) is the exception:
+#   one small palette for the whole GIF keeps a few greens and purples of the hue circle, so it gets 256
+#   colours chosen for each frame (stats_mode=single, new=1). On rainbow_1000 (20 s) the hue distance of its
+#   GIF to its MP4 (tests/test_gif.py's measure) is 0.72 with 48 colours for the whole GIF, 0.28 with 256 for
+#   the whole GIF (9.3 MB) or 96 per frame (8.5 MB), 0.14 with 256 per frame; but that GIF is 11.1 MB, not 5.8.
+MP4_PRESET, MP4_CRF, ROI_QOFFSET = "veryfast", "32", -0.3
+GIF_COLOURS, RAINBOW_COLOURS = 48, 256
+REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
 # at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its 11.5 MB of picture.
 AUDIO_CODEC, AUDIO_RATE, AUDIO_KBPS = "aac", 48_000, 128
 
 
+def roi(video) -> list[str]:
+    """The columns left and right of the pendulums' circle, a finer quantiser there: the HUD's text reads."""
+    side = (video.width - 2 * REACH * video.height) / 2 / video.width
+    if side < 0.02:
+        return []
+    x, q = f"{side:.4f}", ROI_QOFFSET
+    return ["-vf", f"addroi=0:0:iw*{x}:ih:{q},addroi=iw*(1-{x}):0:iw*{x}:ih:{q}"]
+
+
 def mp4_args(video) -> list[str]:
-    return ["-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
+    return [*roi(video), "-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
             "-movflags", "+faststart", "-f", "mp4"]
 
 
 def gif_args(video) -> list[str]:
-    width = min(video.gif_width, video.width)  # downscale only: a small video keeps its own size
-    graph = (f"scale={width}:-2:flags=area,split[a][b];"
-             f"[a]palettegen=stats_mode=diff:max_colors={GIF_COLOURS}[p];"
-             f"[b][p]paletteuse=dither=bayer:bayer_scale=3")
+    """The GIF's frames arrive at its own size (render/video/gif.py): only the palette is made here."""
+    make, use = (f"stats_mode=single:max_colors={RAINBOW_COLOURS}", "new=1:") if video.palette == "rainbow" else \
+        (f"stats_mode=diff:max_colors={GIF_COLOURS}", "")
+    graph = f"split[a][b];[a]palettegen={make}[p];[b][p]paletteuse={use}dither=bayer:bayer_scale=3"
     return ["-vf", graph, "-loop", "0", "-f", "gif"]
-
-
-def gif_rate(video) -> int:
-    return min(video.gif_fps, video.fps)
-
-
-def _near(x: Fraction) -> int:
-    return math.floor(x + Fraction(1, 2))  # ffmpeg's AV_ROUND_NEAR_INF, for x >= 0
-
-
-def gif_repeats(video, frames: int) -> list[int]:
-    """How many GIF frames each video frame becomes (mostly 0 or 1): the GIF's frames are picked here and only
-    those are piped, instead of every frame for ffmpeg's fps filter to drop (2/3 of the pipe at 60 -> 20 fps).
-    The picks are that filter's (eof_action=pass): GIF frame k shows the last video frame whose time, rounded
-    to the GIF's clock, is at most k, for k < ceil(frames·gif/fps); so the GIF is byte-identical to the one the
-    filter made (checked against ffmpeg for 585 rate and length pairs: tests/test_render.py)."""
-    r = Fraction(gif_rate(video), video.fps)
-    slots = math.ceil(frames * r)
-    starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
-    return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
 
 
 ARGS = {"mp4": mp4_args, "gif": gif_args}
@@ -117,9 +116,11 @@ class _Still:
 class _Target:
     """One ffmpeg process, the thread that feeds it, and where its output goes."""
 
-    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None):
+    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None,
+                 small: tuple[int, int] | None = None):
         self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
         self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
+        self.small = small  # the GIF's (width, height): it is fed frames of that size only
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
         self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
@@ -155,6 +156,7 @@ class Encoder:
         self.targets: list[_Target] = []
         self.written = 0
         self.stills: list[_Still] = []
+        self.size = (video.width, video.height)
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         try:
             for fmt in formats or video.formats:
@@ -164,9 +166,9 @@ class Encoder:
                     continue
                 tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
-                rate = gif_rate(video) if fmt == "gif" else video.fps
+                rate, (w, h) = (gif.rate(video), gif.size(video)) if fmt == "gif" else (video.fps, self.size)
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
-                       "-s", f"{video.width}x{video.height}", "-r", str(rate), "-i", "-", "-an",
+                       "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-an",
                        *ARGS[fmt](video), tmp]
                 try:
                     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
@@ -175,8 +177,8 @@ class Encoder:
                     tmp.unlink(missing_ok=True)
                     log.close()
                     raise
-                self.targets.append(_Target(final, tmp, proc, log,
-                                            gif_repeats(video, frames) if fmt == "gif" else None))
+                self.targets.append(_Target(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif"
+                                            else None, gif.size(video) if fmt == "gif" else None))
         except BaseException:
             self.abort()
             raise
@@ -195,10 +197,12 @@ class Encoder:
         else:
             self.abort()
 
-    def write(self, frame: np.ndarray):
-        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind.
+    def write(self, frame: np.ndarray, small: np.ndarray | None = None):
+        """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind. `small` is the
+        GIF's frame for it, drawn at the GIF's size (render/video/gif.py), where the GIF keeps this frame;
+        without it the GIF gets `frame` area-averaged to its size. No frame larger reaches the GIF's pipe.
 
-        The frame is shared, not copied: do not modify it after writing it.
+        The frames are shared, not copied: do not modify them after writing them.
         """
         for t in self.targets:
             if t.error is not None:
@@ -208,8 +212,13 @@ class Encoder:
                     pass
                 raise self._failure("stopped", t.error)
         for t in self.targets:
-            for _ in range(1 if t.repeats is None else t.repeats[self.written]):
-                t.queue.put(frame)
+            n = 1 if t.repeats is None else t.repeats[self.written]
+            if n and t.small is not None:
+                mine = gif.shrink(frame, *t.small) if small is None else small
+                if mine.shape != (t.small[1], t.small[0], 3):
+                    raise ValueError(f"a GIF frame of {mine.shape[1]}x{mine.shape[0]}, not {t.small[0]}x{t.small[1]}")
+            for _ in range(n):
+                t.queue.put(frame if t.small is None else mine)
         self.written += 1
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept

@@ -138,6 +138,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
     wrote. frame_hook(f, frame) sees raw frames."""
     from .encode import Encoder
+    from .gif import Frames
 
     t_start = time.perf_counter()
     src = open_source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
@@ -148,6 +149,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
         voices = audio.Voices(src.sim, scene.video.fps)
     with output_dir(scene.out_dir(out_root)) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video, scene.frames)
+        small = Frames(src, scene.video, timings) if "gif" in scene.video.formats else None  # the GIF's own
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
                 for f in range(scene.frames):
@@ -156,8 +158,9 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                         voices.record()
                     if frame_hook:
                         frame_hook(f, frame)
+                    gif_frame = small.frame(f, frame) if small else None
                     t = time.perf_counter()
-                    enc.write(frame)  # blocks only when the encoder is behind
+                    enc.write(frame, gif_frame)  # blocks only when the encoder is behind
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()

@@ -1,0 +1,170 @@
+"""The GIF's own frames: drawn by the render's canvas at the GIF's size and rate, not shrunk from the video's.
+
+A 720p frame area-averaged down to 352 px turns its 6x13 and 10x20 text into grey mush and its one-pixel rods
+into faint smears. So, where the GIF's size or rate is not the video's, a second canvas of the GIF's size
+draws the same simulation (the same System, the same states: nothing is simulated twice) for the frames the
+GIF keeps, with a HUD laid out for that height (render/draw/hud.py picks its font by the frame's height) and
+trails that fade per GIF frame at the preset's trail_seconds. The frames the GIF skips still stamp their
+stretch of the path into its trails, so a trail is the curve the bob drew, not chords between GIF frames.
+
+A comparison's GIF is a second split screen at the GIF's size drawn from the first one's recorded runs.
+A map's pixels are its pendulums, so a second map would be a second simulation: a map's GIF frame is the
+video's frame area-averaged in numpy (shrink). So is a frame with a Poincaré section (its crossings are read
+once per video frame) and any frame a caller hands the Encoder without a GIF frame of its own.
+
+Which video frames the GIF keeps is ffmpeg's fps filter's choice, made here (repeats) so the pipe carries only
+those.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from fractions import Fraction
+
+import numpy as np
+
+
+def rate(video) -> int:
+    return min(video.gif_fps, video.fps)
+
+
+def size(video) -> tuple[int, int]:
+    """(width, height) of the GIF: gif_width (never upscaled), the height by the frame's aspect, even."""
+    w = min(video.gif_width, video.width)
+    return w, max(2, round(video.height * w / video.width / 2) * 2)
+
+
+def _near(x: Fraction) -> int:
+    return math.floor(x + Fraction(1, 2))  # ffmpeg's AV_ROUND_NEAR_INF, for x >= 0
+
+
+def repeats(video, frames: int) -> list[int]:
+    """How many GIF frames each video frame becomes (mostly 0 or 1): the GIF's frames are picked here and only
+    those are piped, instead of every frame for ffmpeg's fps filter to drop (2/3 of the pipe at 60 -> 20 fps).
+    The picks are that filter's (eof_action=pass): GIF frame k shows the last video frame whose time, rounded
+    to the GIF's clock, is at most k, for k < ceil(frames·gif/fps) (checked against ffmpeg for 90 rate and
+    length pairs: tests/test_encode.py)."""
+    r = Fraction(rate(video), video.fps)
+    slots = math.ceil(frames * r)
+    starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
+    return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
+
+
+def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
+    """An H×W×3 uint8 frame area-averaged down to h×w: each pixel the mean of the area of the frame it covers,
+    partly covered pixels weighted by their share (what ffmpeg's flags=area does). numpy sums in order on
+    one thread, so the bytes never depend on the thread count. Rows first: that pass reads the whole frame,
+    and rows are contiguous."""
+    if frame.shape[:2] == (h, w):
+        return frame
+    rows = _average(frame, h)
+    return np.rint(np.swapaxes(_average(np.swapaxes(rows, 0, 1), w), 0, 1)).clip(0, 255).astype(np.uint8)
+
+
+def _average(a: np.ndarray, m: int) -> np.ndarray:
+    """a (n ≥ m cells along its first axis) averaged down to m: whole cells summed in integers (exact), the
+    cells an edge cuts shared by the fraction on each side."""
+    n = len(a)
+    edges = np.arange(m + 1) * (n / m)
+    k = np.floor(edges).astype(np.int64)  # strictly increasing, since n / m >= 1; k[m] = n
+    frac = (edges - k).reshape(-1, *[1] * (a.ndim - 1))
+    cut = np.take(a, np.minimum(k, n - 1), axis=0) * frac  # frac[m] = 0: nothing past the end
+    whole = np.add.reduceat(a, k[:-1], axis=0, dtype=np.int64 if a.dtype.kind in "ui" else np.float64)
+    return (whole + cut[1:] - cut[:-1]) * (m / n)
+
+
+def _stamp(canvas):
+    """A video frame the GIF skips: the bobs' path since the last one into the GIF canvas's trails, drawn
+    (and faded) with the next frame the GIF keeps. Nothing before the GIF's first frame: there is no path yet."""
+    if canvas.trails and canvas.frame_no:
+        canvas.launch("bob_pixels")
+        canvas.launch("stamp_trails", 0)
+
+
+class _Canvas:
+    """A fan's GIF: a second Canvas of the GIF's size over the render's own System."""
+
+    def __init__(self, src, w: int, h: int, fps: int):
+        from ..draw.canvas import Canvas
+        from ..draw.hud import Info
+
+        v = src.scene.video
+        small = dataclasses.replace(src.scene, video=dataclasses.replace(v, width=w, height=h, fps=fps))
+        self.fps = v.fps
+        info = dataclasses.replace(Info.of(src.scene, src.sim.h, src.cert), one_line=True)
+        self.canvas = Canvas(small, src.sim, info)
+
+    def skip(self, f: int):
+        _stamp(self.canvas)
+
+    def draw(self, f: int) -> np.ndarray:
+        return self.canvas.draw(None, f / self.fps)
+
+
+def _split(src, w: int, h: int, fps: int):
+    """A comparison's GIF: a SplitScreen of the GIF's size sharing the video's recorded runs (pass 1 is not run
+    again), its panels drawn at the GIF's rate with the video's clock."""
+    from ..draw.split import LARGE, Replay, SplitScreen, layout
+
+    class Panel(Replay):
+        def next_frame(self, out=None):
+            self.index += 1
+            self.sim.q.from_numpy(self.q[self.index])
+            return self.canvas.draw(out, self.index / src.scene.video.fps)
+
+        def skip(self, f: int):
+            self.sim.q.from_numpy(self.q[f])
+            _stamp(self.canvas)
+
+    class Split(SplitScreen):
+        def __init__(self):  # the video's split screen did SplitScreen.__init__'s work: share it
+            vars(self).update(vars(src))
+            self.scene = dataclasses.replace(src.scene, video=dataclasses.replace(src.scene.video, width=w, height=h))
+            self.rects = layout(w, h, len(self.runs))
+            self.panels = [Panel(sized(run["scene"], pw, ph), run["q"], run["cert"])
+                           for run, (_, _, pw, ph) in zip(self.runs, self.rects)]
+            self.buffers = [p.canvas.new_frame() for p in self.panels]
+            self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
+            self.timings = {"draw": 0.0}
+
+        def skip(self, f: int):
+            for p in self.panels:
+                p.skip(f)
+
+        def draw(self, f: int) -> np.ndarray:
+            self.index = f - 1
+            for p in self.panels:
+                p.index = f - 1
+            return self.next_frame()
+
+    def sized(scene, pw, ph):
+        return dataclasses.replace(scene, video=dataclasses.replace(scene.video, width=pw, height=ph, fps=fps))
+
+    return Split()
+
+
+class Frames:
+    """The GIF's frames of a frame source (pipeline.Source or a SplitScreen): frame(f, video_frame) gives the
+    GIF's frame for video frame f, or None where the GIF skips f. Its drawing time goes to timings["draw"]."""
+
+    def __init__(self, src, video, timings: dict):
+        self.repeats, self.timings = repeats(video, src.frames), timings
+        self.w, self.h = size(video)
+        self.own = None  # None: the video's frames, area-averaged
+        scene, fps = src.scene, rate(video)
+        if ((self.w, self.h), fps) != ((video.width, video.height), video.fps) and not scene.fractal \
+                and not scene.has("poincare"):
+            self.own = _split(src, self.w, self.h, fps) if scene.compare else _Canvas(src, self.w, self.h, fps)
+
+    def frame(self, f: int, video_frame: np.ndarray) -> np.ndarray | None:
+        t = time.perf_counter()
+        out = None
+        if self.own is None:
+            out = shrink(video_frame, self.w, self.h) if self.repeats[f] else None
+        elif self.repeats[f]:
+            out = self.own.draw(f)
+        else:
+            self.own.skip(f)
+        self.timings["draw"] += time.perf_counter() - t
+        return out

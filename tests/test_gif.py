@@ -1,0 +1,202 @@
+"""The GIF drawn at its own size and rate (render/video/gif.py): its clock reads back, its rainbow stays a rainbow,
+its frames are the small canvas's, the pipe never carries a frame larger than gif_width, and the bytes do
+not depend on the thread count."""
+import re
+import shutil
+import subprocess
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from render.config.scene import load
+from render.video import encode, gif, pipeline
+
+# A frame larger than the GIF's and a rate higher than its own, so the GIF has a canvas of its own; short, since
+# every render compiles its kernels.
+W, H, FPS, SECONDS = 480, 270, 30, 1.5
+GW = 352  # the shipped gif_width: the size its HUD is designed for
+
+
+def scene_of(name, *sets):
+    return load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", f"video.duration={SECONDS}",
+                       'video.formats=["mp4", "gif"]', f"video.gif_width={GW}", *sets])
+
+
+def render(scene, out, threads=1):
+    """Render `scene`, keeping what the GIF's pipe was given (every queued frame's shape) and the GIF frames the
+    pipeline handed the encoder (video frame index -> frame)."""
+    piped, small = [], {}
+    real_init, real_write = encode._Target.__init__, encode.Encoder.write
+
+    def init(self, *a, **kw):
+        real_init(self, *a, **kw)
+        if self.small is not None:
+            put = self.queue.put
+            self.queue.put = lambda x, *b, **c: (piped.append(None if x is None else x.shape), put(x, *b, **c))
+
+    def write(self, frame, gif_frame=None):
+        if gif_frame is not None:
+            small[self.written] = gif_frame.copy()
+        return real_write(self, frame, gif_frame)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(encode._Target, "__init__", init)
+        mp.setattr(encode.Encoder, "write", write)
+        pipeline.render(scene, out, threads=threads)
+    d = scene.out_dir(out)
+    return d / f"{scene.name}.gif", d / f"{scene.name}.mp4", piped, small
+
+
+@pytest.fixture(scope="module")
+def rigid(tmp_path_factory):
+    scene = scene_of("rigid_chaos")
+    return (scene, *render(scene, tmp_path_factory.mktemp("rigid")))
+
+
+def picks(scene) -> list[int]:
+    """The video frame each GIF frame shows (ffmpeg's fps filter's choice, gif.repeats)."""
+    return [i for i, n in enumerate(gif.repeats(scene.video, scene.frames)) for _ in range(n)]
+
+
+# ---------------------------------------------------------------- (1) the clock reads back
+def read_clock(img: np.ndarray) -> float | None:
+    """The clock's seconds in a crop around it, by tesseract; None if it read no clock. A bitmap font's square
+    pixels read poorly as they are: upscaled 4x and softened, dark on light, they read. How soft suits
+    tesseract varies by glyph, so a few blurs are tried in turn until one reads the whole "t = 1.23 s"."""
+    from PIL import Image, ImageFilter
+
+    grey = Image.fromarray(255 - img[..., :3].max(axis=2))
+    big = grey.resize((4 * grey.width, 4 * grey.height), Image.NEAREST)
+    for blur in (1.5, 1.7, 2.0, 1.2, 2.5):
+        soft = np.pad(np.asarray(big.filter(ImageFilter.GaussianBlur(blur))), 20, constant_values=255)
+        cmd = ["tesseract", "stdin", "stdout", "--psm", "7", "-c", "tessedit_char_whitelist=0123456789.ts= "]
+        out = subprocess.run(cmd, input=iio.imwrite("<bytes>", soft, extension=".png"), capture_output=True,
+                             check=True).stdout.decode()
+        found = re.fullmatch(r"\s*t\s*=\s*(\d+\.\d\d)\s*s\s*", out)
+        if found:
+            return float(found[1])
+    return None
+
+
+def clock_read_back(scene, path, crop):
+    """Every GIF frame's clock, read back: each time read is the time of the video frame that GIF frame shows
+    (within a frame), and nearly all frames read (tesseract misses the odd one; it never made one up here)."""
+    frames = iio.imread(path)
+    shown = picks(scene)
+    assert len(frames) == len(shown)
+    read = [read_clock(frame[crop]) for frame in frames]
+    for k, (got, f) in enumerate(zip(read, shown)):
+        t = f / scene.video.fps  # what the clock must say
+        assert got is None or abs(got - t) <= 1 / scene.video.fps + 0.005, (k, got, t)
+    assert sum(got is not None for got in read) >= 0.9 * len(read), read
+    assert len({got for got in read if got is not None}) >= 0.9 * len(read) - 1  # the clock moves
+
+
+needs_tesseract = pytest.mark.skipif(shutil.which("tesseract") is None, reason="tesseract is not installed")
+
+
+@needs_tesseract
+def test_the_clock_reads_back_from_the_gif(rigid):
+    scene, path = rigid[0], rigid[1]
+    clock_read_back(scene, path, np.s_[:17, :90])  # the HUD's clock, top left, in the 6x13 face at 198 px
+
+
+@needs_tesseract
+def test_the_shared_clock_reads_back_from_a_comparisons_gif(tmp_path):
+    scene = scene_of("compare_precision", "video.duration=1.0")
+    path = render(scene, tmp_path)[0]
+    clock_read_back(scene, path, np.s_[:18, GW // 2 - 50:GW // 2 + 50])  # the split screen's band, top centre
+
+
+# ---------------------------------------------------------------- (3) the GIF's frames are the small canvas's
+def psnr(a, b):
+    mse = np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2)
+    return 99.0 if mse == 0 else 10 * np.log10(255.0 ** 2 / mse)
+
+
+def test_the_gif_frames_are_the_gif_canvas_frames(rigid):
+    scene, path, _, piped, small = rigid
+    w, h = gif.size(scene.video)
+    assert (w, h) == (GW, 198)
+    shown = picks(scene)
+    assert sorted(small) == sorted(set(shown))  # a GIF frame was drawn for exactly the video frames it shows
+    frames = iio.imread(path)[..., :3]
+    for k, f in enumerate(shown):
+        # palette quantisation (64 colours, dithered) is all that parts them
+        assert psnr(frames[k], small[f]) >= 24.0, (k, psnr(frames[k], small[f]))
+    # ... and they are not the video's frame shrunk: the text and the rods are drawn for this size
+    assert all(s.shape == (h, w, 3) for s in small.values())
+    # the pipe: only frames of the GIF's size, one per GIF frame, then the end
+    assert piped[-1] is None and set(piped[:-1]) == {(h, w, 3)} and len(piped) - 1 == len(shown)
+
+
+def test_the_gif_is_drawn_not_shrunk(rigid, tmp_path):
+    """The small canvas's frames beat the video's frame area-averaged at reading the HUD: they have its text's
+    full contrast (white glyph pixels) where the shrunk frame has grey."""
+    scene, path, mp4, _, small = rigid
+    first = min(small)
+    big = iio.imread(mp4, index=first)  # decoded: close enough to the raw frame for its text's contrast
+    w, h = gif.size(scene.video)
+    shrunk = gif.shrink(big, w, h)[:17, :90].max(axis=2)
+    drawn = small[first][:17, :90].max(axis=2)
+    assert (drawn >= 230).sum() > 3 * max((shrunk >= 230).sum(), 1)
+
+
+# ---------------------------------------------------------------- (4) thread count
+def test_the_gif_is_byte_identical_at_one_and_two_threads(rigid, tmp_path):
+    scene, path = rigid[0], rigid[1]
+    again = render(scene, tmp_path, threads=2)[0]
+    assert again.read_bytes() == path.read_bytes()
+
+
+# ---------------------------------------------------------------- (2) the rainbow stays a rainbow
+BINS = 36
+
+
+def hue_histogram(frames) -> np.ndarray:
+    """The hue of the coloured pixels (brightest channel > 0.25, chroma > 0.35 of it), in 36 bins of 10°,
+    normalised to sum to one."""
+    counts = np.zeros(BINS)
+    for f in frames:
+        x = f[..., :3].astype(np.float64) / 255
+        hi, lo = x.max(-1), x.min(-1)
+        c = hi - lo
+        sel = (hi > 0.25) & (c > 0.35 * hi)
+        r, g, b, c, hi = x[..., 0][sel], x[..., 1][sel], x[..., 2][sel], c[sel], hi[sel]
+        h = np.where(hi == r, ((g - b) / c) % 6, np.where(hi == g, (b - r) / c + 2, (r - g) / c + 4)) / 6
+        counts += np.bincount(np.minimum((h * BINS).astype(int), BINS - 1), minlength=BINS)
+    return counts / counts.sum()
+
+
+def hue_distance(p, q) -> float:
+    """Total variation between hue histograms: the share of the coloured pixels whose hue lies in another 10°
+    bin (0: the same hues, 1: none in common). A palette that gathers the spectrum on a few hues leaves most
+    bins empty and scores high, even when its few hues are spread around the circle."""
+    return 0.5 * float(np.abs(p - q).sum())
+
+
+def test_hue_distance_is_the_share_of_pixels_moved():
+    p = np.zeros(BINS)
+    p[3] = 1
+    flat = np.full(BINS, 1 / BINS)
+    assert hue_distance(p, p) == 0 and hue_distance(p, np.roll(p, 1)) == 1
+    assert hue_distance(flat, p) == pytest.approx(1 - 1 / BINS)
+    assert hue_distance(flat, np.where(np.arange(BINS) % 2, 2 / BINS, 0)) == pytest.approx(0.5)  # every other hue
+
+
+# Measured at this test's settings (480x270 at 30 fps, 2 s, the GIF 352 px at 20 fps): the video's frame
+# area-averaged with one 64 colour palette (as before) 0.49; drawn at 352 px with one 48 colour palette 0.55;
+# drawn with 256 colours per frame (as now) 0.32. What is left is mostly the drawing, not the palette: thin
+# lines of light cover a larger share of a smaller frame, so its coloured pixels are not weighted alike.
+HUE_LIMIT = 0.4
+
+
+def test_the_rainbow_gif_keeps_the_videos_hues(tmp_path):
+    """rainbow_1000's GIF against its MP4: the hues of the coloured pixels, compared as histograms. With one
+    small palette for the whole GIF its hues gather on a few greens and purples; 256 colours per frame keep
+    the spectrum (HUE_LIMIT)."""
+    scene = scene_of("rainbow_1000", "video.duration=2.0")
+    path, mp4 = render(scene, tmp_path)[:2]
+    d = hue_distance(hue_histogram(iio.imiter(mp4)), hue_histogram(iio.imiter(path)))
+    assert d < HUE_LIMIT, d
