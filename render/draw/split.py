@@ -58,6 +58,21 @@ def shown(lines: list, room: int) -> list:
     return [lines[k] for k in kept if k not in drop]
 
 
+def label_face(height: int) -> tuple[str, int, int, int]:
+    """A label's font for panels `height` pixels high: (size, padding, line step, cell width) in pixels."""
+    return ("10x20", 8, 21, 10) if height >= LARGE else ("6x13", 4, 13, 6)
+
+
+def label_band(scene, height: int) -> int:
+    """How many pixels from a panel's top its label covers: as many lines as labels() shows there."""
+    _, pad_, step_, _ = label_face(height)
+    room = max(2, int(LABEL_SHARE * height) // step_)
+    named = dict(scene.compare)
+    lines = [("variant", None), ("" if all(k in named for k in INTEGRATOR) else "integrator", None),
+             ("cost", None), ("error", None), ("faithful", None)]  # label_lines' lines, by whether they are empty
+    return pad_ // 2 + len(shown(lines, room)) * step_ + pad_ // 2
+
+
 def fit(text: str, width: int, cell: int) -> str:
     """Text cut to `width` pixels of `cell`-wide glyphs, so a label stays inside its panel."""
     room = max(width // cell, 1)
@@ -136,7 +151,7 @@ class Replay:
     """One variant's recorded states drawn at its panel's size by the canvas `render` draws with: a frame
     source with pipeline.Source's interface (name, frames, index, reset(), next_frame(out=None))."""
 
-    def __init__(self, scene, q: np.ndarray, cert):
+    def __init__(self, scene, q: np.ndarray, cert, keep_clear=()):
         from .canvas import Canvas
         from .hud import Info
 
@@ -144,7 +159,7 @@ class Replay:
         self.name, self.frames = scene.name, len(q)
         self.sim = registry.get(scene.system)(scene)
         # the HUD, if called for, with the variant's own certificate: its clock's colours and timeline ticks
-        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True))
+        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True), keep_clear)
         self.reset(rewind=False)
 
     def reset(self, rewind: bool = True):
@@ -174,7 +189,9 @@ class SplitScreen:
         v = scene.video
         self.rects = layout(v.width, v.height, len(self.runs))
         self.arch = runtime.init(arch, "f64", threads)  # pass 2: f64 positions, drawn in f32 pixels as ever
-        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"])
+        # each panel's label owns a band across its top: the panel's canvas frames its pendulums below it
+        self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"],
+                              [(0, 0, w - 1, label_band(scene, h) - 1)])
                        for run, (_, _, w, h) in zip(self.runs, self.rects)]
         self.buffers = [p.canvas.new_frame() for p in self.panels]
         self.angles = registry.get(scene.system).ANGLES
@@ -185,7 +202,7 @@ class SplitScreen:
         self.costs = [cost(run) for run in self.runs]
         self.delta = "Δθ" if self.angles else "Δx/L"  # what the error measures: rad, or of the total length
         self.font = Font()
-        self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
+        self.size = label_face(self.rects[0][3])[0]
         self.timings = {k: sum(run["timings"].get(k, 0.0) for run in self.runs)
                         for k in ("quality", "certify", "simulate") if any(k in run["timings"] for run in self.runs)}
         self.timings["draw"] = 0.0
@@ -247,8 +264,7 @@ class SplitScreen:
 
     def labels(self, f: int) -> list[tuple]:
         """Every panel's label (and, with 3 variants, the legend in the free cell) as Font.draw_many items."""
-        big = self.size == "10x20"
-        pad_, step_, cell = (8, 21, 10) if big else (4, 13, 6)
+        _, pad_, step_, cell = label_face(self.rects[0][3])
         room = max(2, int(LABEL_SHARE * self.rects[0][3]) // step_)  # a small panel keeps its pendulums in view
         cells = [(rect, shown(self.label_lines(i, f), room)) for i, rect in enumerate(self.rects)]
         if len(self.rects) == 3:
