@@ -5,16 +5,21 @@
     top right     the certificate: until when all, and half, of the pendulums are faithful
     bottom left   the live spread of the fan: the largest distance between neighbouring pendulums' last bobs,
                   on a log scale over the whole video's time axis, drawn up to now; under it the timeline,
-                  with ticks where the render stops being faithful (the same times as the top right)
-    bottom right  a one-line caption: the preset's description, cut to fit
+                  with ticks where the render stops being faithful (the same times as the top right; two
+                  that would coincide are drawn a dark column apart), and under that its times: 0, each
+                  tick's, the end
+    bottom right  the caption: the preset's description, right-aligned, wrapped around the pendulums' view
+                  (up to MAX_LINES lines, then cut with an ellipsis)
 
 In a split-screen panel (render/draw/split.py) the panel's label says the method, step, cost and error at the top,
-so the HUD keeps the spread and the timeline and puts the clock where the caption was.
+so the HUD keeps the spread and the timeline and puts the clock where the caption was. Under glow (rainbow_1000,
+where the picture is the point) it is minimal: the clock and the spread chart, no method, certificate or caption.
 
-The left and right columns lie outside the circle the pendulums can reach (the canvas frames it at 0.92 of
-the height), so the HUD covers no pendulum on a 16:9 frame. Sizes follow the frame's height (faces()); at
-small sizes (under 360 px) the certificate's words and the axis labels are left out and its ticks and the
-clock's colour carry it. Everything is clipped to the frame.
+Where it draws is known before the first frame: every text at its widest (the font is monospaced) and the
+chart are boxes (self.boxes), and the canvas fits the pendulums' view, everything they can ever reach, clear of
+them (render/draw/framing.py). So the HUD never covers a pendulum, at any size or aspect ratio. Sizes follow the
+frame's height (faces()); at small sizes (under 360 px) the certificate's words and the axis labels are left
+out and its ticks and the clock's colour carry it. Everything is clipped to the frame.
 
 It draws into the finished uint8 frame, after the canvas composed it, so it is the same under max or glow
 compositing. The text that never changes (the method, the step, the certificate, the caption, the axis labels)
@@ -45,7 +50,7 @@ UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 # work than waking the thread pool for each of them (rigid_chaos, 720p, 2 threads, a busy 2-core machine: 0.8 ms
 # a frame so, 1.4 ms with the pool). Either way each pixel has one writer, so the bytes are the same.
 SERIAL_MAX_THREADS = 4
-MAX_LINES = 6  # of the caption
+MAX_LINES = 8  # of the caption
 
 
 @dataclasses.dataclass(frozen=True)
@@ -161,7 +166,7 @@ class Hud(runtime.Launcher):
         caption = []
         if not (info.panel or self.minimal):  # the video's caption, not a panel's
             below = [framing.box_of(r) for r in chart + value] + [graph]
-            above = [framing.box_of(r) for r in corners + clock]
+            above = [framing.box_of(r) for r in corners[2:]]  # the certificate, over the caption's column
             left = max(b[2] for b in below if b is not None) + 2 * m
             top = max([b[3] for b in above if b is not None] + [0]) + m
             caption = self.caption(" ".join(info.caption.split()), view, left, top)

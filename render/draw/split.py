@@ -7,7 +7,8 @@ Two passes, because Taichi holds one precision per process (render/physics/runti
 1. each variant is simulated to the end in its own runtime exactly as `render` simulates it (--quality,
    the certificate, the watchdogs: pipeline.record), keeping its state at every frame time, and timed;
 2. one runtime then draws each panel from those states with a Canvas of the panel's size (Replay, a frame
-   source like pipeline.Source), and every label in one kernel launch of the bundled font.
+   source like pipeline.Source), and every label in one kernel launch of the bundled font. A label owns a band
+   across its panel's top (label_band), and the panel's canvas frames its pendulums' whole reach below it.
 
 The finest variant is the one its certificate trusts longest (median, then first pendulum's faithful time);
 ties go to f64, the higher order, the smaller step, then the order given. It is only the best of those shown,
