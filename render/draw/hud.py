@@ -51,6 +51,7 @@ UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 # a frame so, 1.4 ms with the pool). Either way each pixel has one writer, so the bytes are the same.
 SERIAL_MAX_THREADS = 4
 MAX_LINES = 8  # of the caption
+MIN_CHARS = 12  # a caption's column narrower than this is left out: a word a line reads as noise
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,8 +105,8 @@ def metres(d: float) -> str:
 
 
 def wrap(s: str, chars: int) -> list[str]:
-    """s in lines of at most `chars` characters, broken at spaces (a longer word cut); [] if chars < 4."""
-    if chars < 4:
+    """s in lines of at most `chars` characters, broken at spaces (a longer word cut); [] if chars < MIN_CHARS."""
+    if chars < MIN_CHARS:
         return []
     lines = []
     for word in s.split():
