@@ -11,8 +11,8 @@ VIDEO = {"width": 160, "height": 90, "fps": 10, "duration": 0.5}
 PEND = {"theta1": 2.0, "theta2": 2.6, "spread": 0.1}
 
 
-def render(tmp_path, system="rigid", effects=("rods", "bobs"), **pend):
-    scene = make_scene(system, 4, effects=list(effects), pendulums={**PEND, **pend}, video=VIDEO)
+def render(tmp_path, system="rigid", effects=("rods", "bobs"), video=VIDEO, **pend):
+    scene = make_scene(system, 4, effects=list(effects), pendulums={**PEND, **pend}, video=video)
     frames = []
     meta = pipeline.render(scene, tmp_path / "_".join(effects), frame_hook=lambda f, fr: frames.append(fr.copy()))
     return meta, np.stack(frames)
@@ -95,9 +95,12 @@ def hud_work(names):
 
 
 def test_the_hud_is_only_paid_for_when_asked_and_only_adds_light(tmp_path):
-    base, without = render(tmp_path, effects=("rods", "bobs"))
+    # at 320x180 the HUD fits around the pendulums' nominal view (at 160x90 its corners would reach into it,
+    # and the view would shrink to keep clear of them: render/draw/framing.py)
+    video = {**VIDEO, "width": 320, "height": 180}
+    base, without = render(tmp_path, effects=("rods", "bobs"), video=video)
     assert hud_work(base["kernels"]) == [] and hud_work(base["fields"]) == []
-    more, with_hud = render(tmp_path, effects=("rods", "bobs", "hud"))
+    more, with_hud = render(tmp_path, effects=("rods", "bobs", "hud"), video=video)
     added = [k for k in more["kernels"] if k not in base["kernels"]]
     assert sorted(added) == ["hud_draw", "hud_spread", "text_bytes"], added  # text_bytes once, for the static text
     new_fields = set(more["fields"]) - set(base["fields"])

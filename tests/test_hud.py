@@ -13,9 +13,9 @@ from render.config.scene import load
 W, H, FPS = 256, 144, 10
 
 
-def run(name, info=None, upto=None, sets=()):
+def run(name, info=None, upto=None, sets=(), size=(W, H)):
     """Draw a preset's frames with the HUD on (small, short); returns the canvas, the frames and the system."""
-    scene = load(name, [f"video.width={W}", f"video.height={H}", f"video.fps={FPS}", "video.duration=0.5",
+    scene = load(name, [f"video.width={size[0]}", f"video.height={size[1]}", f"video.fps={FPS}", "video.duration=0.5",
                         'effects=["bobs", "hud"]', *sets])
     from render.draw.canvas import Canvas
 
@@ -75,17 +75,23 @@ def test_the_clock_turns_amber_then_red_past_the_certificates_marks_and_the_time
     assert below_axis[h.x_of(0.15) + 1:h.x_of(0.25)].max() == 0
 
 
-def test_a_long_caption_is_cut_to_its_strip_and_nothing_leaves_the_corners():
-    long = "x" * 300
-    canvas, frames, _ = run("rigid_chaos", hud.Info(long, "rk4", 1e-3, "f64"), upto=0)
-    _, plain, _ = run("rigid_chaos", upto=0, sets=['effects=["bobs"]'])
+def test_a_long_caption_wraps_in_its_corner_around_the_view_and_is_cut_there():
+    w, h_px = 640, 360
+    long = "word " * 300
+    canvas, frames, _ = run("rigid_chaos", hud.Info(long, "rk4", 1e-3, "f64"), upto=0, size=(w, h_px))
+    _, plain, _ = run("rigid_chaos", upto=0, sets=['effects=["bobs"]'], size=(w, h_px))
     added = (frames[0] != plain[0]).any(2)
     h = canvas.hud
     rows, cols = np.nonzero(added)
-    assert cols.max() <= W - h.m - 1 and rows.max() <= H - h.m
-    strip = added[H - h.m - 13:H - h.m]
-    caption_cols = np.nonzero(strip[:, h.gx1 + 1:].any(0))[0] + h.gx1 + 1
-    assert caption_cols.min() > h.gx1 and caption_cols.max() >= W - h.m - 6  # cut, up to its last cell
+    assert cols.max() <= w - h.m - 1 and rows.max() <= h_px - h.m
+    view = canvas.view
+    right = added[:, int(view.cx):]  # right of the pivot: the certificate (none here) and the caption
+    lines = np.nonzero(right.any(1))[0]
+    assert len(lines) and lines.min() > view.cy  # the caption only, below the pivot
+    assert not (added & view.reachable(h_px, w)).any()
+    caption = [r for r in h.boxes if r[0] > view.cx]
+    assert len(caption) == hud.MAX_LINES  # wrapped to its most lines, the last one cut with an ellipsis
+    assert all(r[2] == w - h.m - 1 for r in caption)  # right-aligned
     assert added.mean() < 0.1  # the HUD is a frame around the picture, not over it
 
 

@@ -3,7 +3,8 @@
 Antialiased coverage comes from the distance to each segment or circle. Primitives are composited with a
 max per channel (atomic where they are drawn in parallel), which does not depend on drawing order, so frames
 are byte-identical across runs and thread counts. Each effect has its own kernel, launched (and compiled)
-only when the scene calls for it.
+only when the scene calls for it. The pendulums' view (render/draw/framing.py) holds everything they can
+ever reach, clear of the HUD's boxes and of what the caller draws over the frame (keep_clear).
 
 Speed (see benchmarks/README.md): a 720p frame is 0.9 M pixels, but a few hundred pendulums touch only a
 small part of it. Compositing works on TILE×TILE tiles that remember whether this frame's rods and bobs or a
@@ -15,6 +16,7 @@ import numpy as np
 import taichi as ti
 
 from ..physics import runtime
+from . import framing
 
 COILS = 14  # zig-zag segments per spring
 LEAD = 0.12  # straight fraction at each end of a spring
@@ -44,9 +46,10 @@ def to_byte(c):
 class Canvas(runtime.Launcher):
     TILE = TILE  # for render/draw/glow.py, which composes the canvas's tiles
 
-    def __init__(self, scene, sim, info=None):
+    def __init__(self, scene, sim, info=None, keep_clear=()):
         """info: what the `hud` effect says beyond the drawing contract (render/draw/hud.py's Info; from the scene
-        alone if not given)."""
+        alone if not given). keep_clear: boxes (x0, y0, x1, y1) of this frame that something else draws over
+        (a split-screen panel's label): the pendulums' view keeps clear of them, as of the HUD's."""
         v, self.scene, self.sim = scene.video, scene, sim
         self.w, self.h, self.n = v.width, v.height, sim.n
         self.rods, self.springs, self.bobs_on = scene.has("rods"), scene.has("springs"), scene.has("bobs")
@@ -70,23 +73,33 @@ class Canvas(runtime.Launcher):
             from ..physics.keys import DRAWN
             area = self.w // 2 if any(scene.has(e) for e in DRAWN) else 0
             self.section = Section(self, scene, sim, area, self.w - area)
-        self.cx, self.cy = 0.5 * area, 0.5 * self.h
-        # pixels per metre, the pivot at the centre of its area: the full reach fits with a margin
-        self.scale = 0.46 * min(area or self.w, self.h) / sim.reach()
+        self.area = area or self.w
         self.lw = max(0.6, 0.0011 * self.h)  # half-width of rods, coils and trails in pixels
+        self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
+        # how far a drawing spills past the chain's points: a bob's disc, a line's width (under glow a hairline
+        # two pixels wide), a coil's zig-zag (at most the nominal amplitude: a fitted view is never larger)
+        nominal = framing.SHARE * min(self.area, self.h) / sim.reach()  # px per metre
+        spill = max(self.radii) + 0.5 if self.bobs_on else 0.0  # a disc covers pixels closer than r + 0.5
+        pad = max(spill, self.lw + 0.5, 2.0) + 0.5
+        pad += 0.035 * nominal * min(sim.lengths) if self.springs else 0.0
+        self.hud = None
+        if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
+            from .hud import Hud, Info
+            self.hud = Hud(scene, sim, info or Info.of(scene), self.area, self.h,
+                           framing.fit(self.area, self.h, pad))
+        # the pendulums' view: their whole reach, clear of the HUD's text and anything else drawn over them
+        boxes = list(keep_clear) + (self.hud.boxes if self.hud is not None else [])
+        self.view = framing.fit(self.area, self.h, pad, boxes)
+        self.cx, self.cy = self.view.cx, self.view.cy
+        self.scale = self.view.radius / sim.reach()  # pixels per metre
         self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
         self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
         self.tip = len(self.links) - 1
-        self.radii = tuple(max(2.0, 0.013 * self.h * size) for size in sim.bob_sizes())
         self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
             self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
-        self.hud = None
-        if scene.has("hud"):  # imported only when called for: no HUD, no font field, no HUD kernel
-            from .hud import Hud, Info
-            self.hud = Hud(scene, sim, info or Info.of(scene), self.w, self.h)
         self.fps = v.fps
         self.frame_no = 0
 

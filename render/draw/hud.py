@@ -5,16 +5,21 @@
     top right     the certificate: until when all, and half, of the pendulums are faithful
     bottom left   the live spread of the fan: the largest distance between neighbouring pendulums' last bobs,
                   on a log scale over the whole video's time axis, drawn up to now; under it the timeline,
-                  with ticks where the render stops being faithful (the same times as the top right)
-    bottom right  a one-line caption: the preset's description, cut to fit
+                  with ticks where the render stops being faithful (the same times as the top right; two
+                  that would coincide are drawn a dark column apart), and under that its times: 0, each
+                  tick's, the end
+    bottom right  the caption: the preset's description, right-aligned, wrapped around the pendulums' view
+                  (up to MAX_LINES lines, then cut with an ellipsis)
 
 In a split-screen panel (render/draw/split.py) the panel's label says the method, step, cost and error at the top,
-so the HUD keeps the spread and the timeline and puts the clock where the caption was.
+so the HUD keeps the spread and the timeline and puts the clock where the caption was. Under glow (rainbow_1000,
+where the picture is the point) it is minimal: the clock and the spread chart, no method, certificate or caption.
 
-The left and right columns lie outside the circle the pendulums can reach (the canvas frames it at 0.92 of
-the height), so the HUD covers no pendulum on a 16:9 frame. Sizes follow the frame's height (faces()); at
-small sizes (under 360 px) the certificate's words and the axis labels are left out and its ticks and the
-clock's colour carry it. Everything is clipped to the frame.
+Where it draws is known before the first frame: every text at its widest (the font is monospaced) and the
+chart are boxes (self.boxes), and the canvas fits the pendulums' view, everything they can ever reach, clear of
+them (render/draw/framing.py). So the HUD never covers a pendulum, at any size or aspect ratio. Sizes follow the
+frame's height (faces()); at small sizes (under 360 px) the certificate's words and the axis labels are left
+out and its ticks and the clock's colour carry it. Everything is clipped to the frame.
 
 It draws into the finished uint8 frame, after the canvas composed it, so it is the same under max or glow
 compositing. The text that never changes (the method, the step, the certificate, the caption, the axis labels)
@@ -34,6 +39,7 @@ import numpy as np
 import taichi as ti
 
 from ..physics import runtime
+from . import framing
 from .font import Font, text_width
 
 WHITE, DIM, FAINT = (0.92, 0.92, 0.92), (0.55, 0.55, 0.55), (0.22, 0.22, 0.22)
@@ -44,6 +50,8 @@ UNITS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 # work than waking the thread pool for each of them (rigid_chaos, 720p, 2 threads, a busy 2-core machine: 0.8 ms
 # a frame so, 1.4 ms with the pool). Either way each pixel has one writer, so the bytes are the same.
 SERIAL_MAX_THREADS = 4
+MAX_LINES = 8  # of the caption
+MIN_CHARS = 12  # a caption's column narrower than this is left out: a word a line reads as noise
 
 
 @dataclasses.dataclass(frozen=True)
@@ -97,6 +105,20 @@ def metres(d: float) -> str:
     return "< 1 nm"
 
 
+def wrap(s: str, chars: int) -> list[str]:
+    """s in lines of at most `chars` characters, broken at spaces (a longer word cut); [] if chars < MIN_CHARS."""
+    if chars < MIN_CHARS:
+        return []
+    lines = []
+    for word in s.split():
+        word = fit(word, chars)
+        if lines and len(lines[-1]) + 1 + len(word) <= chars:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    return lines
+
+
 def fit(s: str, chars: int) -> str:
     """s cut to `chars` characters, with an ellipsis when it was longer."""
     return s if len(s) <= chars else (s[:max(chars - 1, 0)].rstrip() + "…" if chars > 0 else "")
@@ -104,39 +126,55 @@ def fit(s: str, chars: int) -> str:
 
 @ti.data_oriented
 class Hud(runtime.Launcher):
-    def __init__(self, scene, sim, info: Info, w: int, h: int):
+    def __init__(self, scene, sim, info: Info, w: int, h: int, view=None):
+        """view: the pendulums' nominal view (render/draw/framing.py's View), which the caption wraps around;
+        the canvas then fits the view clear of every box in self.boxes."""
         self.sim, self.info, self.w, self.h = sim, info, w, h
         v = scene.video
         self.fps, self.duration, self.frames = v.fps, v.duration, scene.frames
         self.n, self.tip, self.reach = sim.n, len(sim.LINKS) - 1, sim.reach()
         self.fan = self.n > 1  # a spread needs neighbours
+        self.minimal = scene.has("glow")  # where the look is the point: the clock and the chart, no prose
         (self.small, ss), (self.big, bs), (self.lab, ls) = faces(h)
         self.ss, self.bs, self.ls = ss, bs, ls
         self.words = h >= 360  # room for the certificate's words and the axis labels
         self.font = Font(self.small)
         self.serial = ti.lang.impl.current_cfg().cpu_max_num_threads <= SERIAL_MAX_THREADS
         m = self.m = max(3, round(0.016 * h))
-        sh, bh = self.cell(self.small, ss)[1], self.cell(self.big, bs)[1]
+        sh, bh, lh = self.cell(self.small, ss)[1], self.cell(self.big, bs)[1], self.cell(self.lab, ls)[1]
         self.th = max(1, h // 360)  # line thickness
-        # the panel: the spread graph over the video's time axis, the timeline under it
+        # the panel: the spread graph over the video's time axis, the timeline under it, its times under that
         self.gx0, self.gw = m, max(16, round(0.38 * h))
         self.gx1 = self.gx0 + self.gw
-        self.gy1 = h - m - 1 - 3 * self.th
+        self.gy1 = h - m - 1 - 3 * self.th - (lh + self.th if self.words else 0)
         self.gy0 = self.gy1 - (max(8, round(0.12 * h)) if self.fan else 0)
         self.value_at = (self.gx0, self.gy0 - max(2, m // 3) - sh)
         self.until = [(t, c) for t, c in ((info.faithful_until_s, AMBER), (info.median_until_s, RED))
                       if t is not None and t < self.duration]
-        self.ticks = tuple(self.x_of(t) for t, _ in self.until) + (-1,) * (2 - len(self.until))
+        xs = [self.x_of(t) for t, _ in self.until]
+        if len(xs) == 2 and xs[1] < xs[0] + 2 * self.th + 1:  # ticks that coincide: the later one just right of
+            xs[1] = xs[0] + 2 * self.th + 1  # the other, with a dark column between (their labels say the times)
+        self.ticks = tuple(xs) + (-1,) * (2 - len(xs))
         self.tick_colours = tuple(c for _, c in self.until) + (WHITE,) * (2 - len(self.until))
         self.tick_times = tuple(float(t) for t, _ in self.until) + (math.inf,) * (2 - len(self.until))
-        rows = self.axis_labels()
-        if not info.panel:  # a panel's label covers its top, and the caption is the video's, not the panel's
-            rows += [self.text(f"{info.method} · {info.precision}", m, m + bh + m // 2),
-                     self.text(f"dt = {step(info.dt)} s", m, m + bh + m // 2 + sh)] + self.certificate()
-            right = self.gx1 + (self.cell(self.lab, ls)[0] * 5 if self.fan and self.words else 0) + 2 * m
-            chars = (w - m - right) // self.cell(self.small, ss)[0]
-            rows.append(self.text(fit(" ".join(info.caption.split()), chars), w - m, h - m, DIM, ha="right",
-                                  va="bottom"))
+        chart = self.axis_labels() + self.time_labels()
+        corners = [] if info.panel or self.minimal else [  # a panel's label says these; glow shows the picture
+            self.text(f"{info.method} · {info.precision}", m, m + bh + m // 2),
+            self.text(f"dt = {step(info.dt)} s", m, m + bh + m // 2 + sh)] + self.certificate()
+        # what changes per frame, at its widest (the font is monospaced): the clock, the spread's value, the chart
+        clock = [self.clock_rows(f"t = {max(self.duration, 10.0):5.2f} s", WHITE)]
+        value = [self.value_rows(8.88e-3)] if self.fan else []
+        graph = (self.gx0, self.gy0 - self.th, max([self.gx1] + [x + self.th - 1 for x in xs]), self.gy1 + 3 * self.th)
+        caption = []
+        if not (info.panel or self.minimal):  # the video's caption, not a panel's
+            below = [framing.box_of(r) for r in chart + value] + [graph]
+            above = [framing.box_of(r) for r in corners[2:]]  # the certificate, over the caption's column
+            left = max(b[2] for b in below if b is not None) + 2 * m
+            top = max([b[3] for b in above if b is not None] + [0]) + m
+            caption = self.caption(" ".join(info.caption.split()), view, left, top)
+        boxes = [framing.box_of(r) for r in chart + corners + clock + value + caption] + [graph]
+        self.boxes = [b for b in boxes if b is not None]  # where the HUD draws: the view keeps clear of them
+        rows = chart + corners + caption
         self.layer, self.lit = self.bake(rows)
         if self.fan:
             self.spread = runtime.field("hud.spread", runtime.real(), ())
@@ -179,6 +217,55 @@ class Hud(runtime.Launcher):
         sh = self.cell(self.small, self.ss)[1]
         return [self.text(s, self.w - self.m, self.m + k * sh, c, ha="right") for k, (s, c) in enumerate(lines)]
 
+    def time_labels(self) -> list:
+        """Under the timeline: 0, the end and each tick's time in its colour, left to right without overlap."""
+        if not self.words:
+            return []
+        y, cw = self.gy1 + 4 * self.th, self.cell(self.lab, self.ls)[0]
+        items = [("0", self.gx0, DIM)] + [(f"{t:.2f}", x, c) for (t, c), x in zip(self.until, self.ticks)]
+        end = f"{self.duration:g} s"
+        out, free = [], self.gx0
+        for k, (s, x, c) in enumerate(items):
+            left = max(x - (len(s) * cw) // 2 if k else x, free)
+            out.append(self.text(s, left, y, c, self.lab, self.ls))
+            free = left + (len(s) + 1) * cw
+        right = max(self.gx1, free + len(end) * cw)  # the end's label, right-aligned under the end, or after the rest
+        return out + [self.text(end, right, y, DIM, self.lab, self.ls, ha="right")]
+
+    def caption(self, text: str, view, left: int, top: int) -> list:
+        """The caption in the bottom right corner, right-aligned, wrapped around the pendulums' view (at most
+        MAX_LINES lines, cut with an ellipsis if it still does not fit), right of `left` and below `top`."""
+        cw, sh = self.cell(self.small, self.ss)
+        best = []
+        for n in range(1, MAX_LINES + 1):
+            y0, y1 = self.h - self.m - n * sh, self.h - self.m - 1
+            if y0 < top:
+                break
+            x0 = left
+            if view is not None:
+                dy = max(y0 - view.cy, view.cy - y1, 0.0)
+                r = view.outer + framing.GAP + 1
+                if dy < r:
+                    x0 = max(x0, math.ceil(view.cx + math.sqrt(r * r - dy * dy)))
+            chars = (self.w - self.m - x0) // cw
+            lines = wrap(text, chars)
+            if not lines:
+                continue
+            best = lines if len(lines) <= n else lines[:n - 1] + [fit(" ".join(lines[n - 1:]), chars)]
+            if len(lines) <= n:
+                break
+        return [self.text(s, self.w - self.m, self.h - self.m - (len(best) - k) * sh, DIM, ha="right")
+                for k, s in enumerate(best)]
+
+    def clock_rows(self, s: str, colour):
+        """The clock: top left, or in a panel (whose label covers its top) bottom right."""
+        if self.info.panel:
+            return self.text(s, self.w - self.m, self.h - self.m, colour, self.big, self.bs, ha="right", va="bottom")
+        return self.text(s, self.m, self.m, colour, self.big, self.bs)
+
+    def value_rows(self, spread: float):
+        return self.text(f"{'spread' if self.words else 'Δ'} {metres(spread)}", *self.value_at, CURVE)
+
     def axis_labels(self) -> list:
         """Decades of the spread axis, in metres, right of the graph."""
         if not (self.fan and self.words):
@@ -206,12 +293,9 @@ class Hud(runtime.Launcher):
         """The HUD at simulated time t into the finished frame `out` (H×W×3 uint8)."""
         frame = min(max(int(round(t * self.fps)), 0), self.frames - 1)
         spread = self.launch("hud_spread", frame) if self.fan else 0.0  # returned: no field read to launch
-        clock = f"t = {t:5.2f} s"
-        lines = [self.text(clock, self.w - self.m, self.h - self.m, self.clock_colour(t), self.big, self.bs,
-                           ha="right", va="bottom") if self.info.panel else
-                 self.text(clock, self.m, self.m, self.clock_colour(t), self.big, self.bs)]
+        lines = [self.clock_rows(f"t = {t:5.2f} s", self.clock_colour(t))]
         if self.fan:
-            lines.append(self.text(f"{'spread' if self.words else 'Δ'} {metres(spread)}", *self.value_at, CURVE))
+            lines.append(self.value_rows(spread))
         self.launch("hud_draw", out, frame, self.x_of(t), np.concatenate(lines), len(lines[0]))
 
     @ti.kernel

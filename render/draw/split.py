@@ -7,7 +7,8 @@ Two passes, because Taichi holds one precision per process (render/physics/runti
 1. each variant is simulated to the end in its own runtime exactly as `render` simulates it (--quality,
    the certificate, the watchdogs: pipeline.record), keeping its state at every frame time, and timed;
 2. one runtime then draws each panel from those states with a Canvas of the panel's size (Replay, a frame
-   source like pipeline.Source), and every label in one kernel launch of the bundled font.
+   source like pipeline.Source), and every label in one kernel launch of the bundled font. A label owns a band
+   across its panel's top (label_band), and the panel's canvas frames its pendulums' whole reach below it.
 
 The finest variant is the one its certificate trusts longest (median, then first pendulum's faithful time);
 ties go to f64, the higher order, the smaller step, then the order given. It is only the best of those shown,
@@ -57,6 +58,21 @@ def shown(lines: list, room: int) -> list:
     kept = [k for k, (text, _) in enumerate(lines) if text]
     drop = [k for k in DROP if k in kept][:max(0, len(kept) - room)]
     return [lines[k] for k in kept if k not in drop]
+
+
+def label_face(height: int) -> tuple[str, int, int, int]:
+    """A label's font for panels `height` pixels high: (size, padding, line step, cell width) in pixels."""
+    return ("10x20", 8, 21, 10) if height >= LARGE else ("6x13", 4, 13, 6)
+
+
+def label_band(scene, height: int) -> int:
+    """How many pixels from a panel's top its label covers: as many lines as labels() shows there."""
+    _, pad_, step_, _ = label_face(height)
+    room = max(2, int(LABEL_SHARE * height) // step_)
+    named = dict(scene.compare)
+    lines = [("variant", None), ("" if all(k in named for k in INTEGRATOR) else "integrator", None),
+             ("cost", None), ("error", None), ("faithful", None)]  # label_lines' lines, by whether they are empty
+    return pad_ // 2 + len(shown(lines, room)) * step_ + pad_ // 2
 
 
 def fit(text: str, width: int, cell: int) -> str:
@@ -138,7 +154,7 @@ class Replay:
     source with pipeline.Source's interface (name, frames, index, reset(), next_frame(out=None))."""
 
     def __init__(self, scene, q: np.ndarray, cert, arch: str = "cpu", threads: int | None = None,
-                 keep_log: bool = False):
+                 keep_log: bool = False, keep_clear=()):
         from .canvas import Canvas
         from .hud import Info
 
@@ -148,7 +164,7 @@ class Replay:
         self.run = Run(scene, arch, threads, precision="f64", keep_log=keep_log)
         self.sim = self.run.sim
         # the HUD, if called for, with the variant's own certificate: its clock's colours and timeline ticks
-        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True))
+        self.canvas = Canvas(scene, self.sim, Info.of(scene, self.sim.h, cert, panel=True), keep_clear)
         self.reset(rewind=False)
 
     def reset(self, rewind: bool = True):
@@ -177,10 +193,11 @@ class SplitScreen:
         self.ref = finest(self.runs)
         v = scene.video
         self.rects = layout(v.width, v.height, len(self.runs))
+        # each panel's label owns a band across its top: the panel's canvas frames its pendulums below it
         self.panels = [Replay(run["scene"].replace(video={"width": w, "height": h}), run["q"], run["cert"], arch,
-                              threads, keep_log=k > 0)
+                              threads, keep_log=k > 0, keep_clear=[(0, 0, w - 1, label_band(scene, h) - 1)])
                        for k, (run, (_, _, w, h)) in enumerate(zip(self.runs, self.rects))]
-        self.arch = self.panels[0].run.arch
+        self.arch, self.threads = self.panels[0].run.arch, threads  # a second split screen (the GIF's) shares them
         self.buffers = [p.canvas.new_frame() for p in self.panels]
         self.angles = registry.get(scene.system).ANGLES
         ref_q, sim = self.runs[self.ref]["q"], self.panels[self.ref].sim
@@ -190,7 +207,7 @@ class SplitScreen:
         self.costs = [cost(run) for run in self.runs]
         self.delta = "Δθ" if self.angles else "Δx/L"  # what the error measures: rad, or of the total length
         self.font = Font()
-        self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
+        self.size = label_face(self.rects[0][3])[0]
         self.timings = {k: sum(run["timings"].get(k, 0.0) for run in self.runs)
                         for k in ("quality", "certify", "simulate") if any(k in run["timings"] for run in self.runs)}
         self.timings["draw"] = 0.0
@@ -252,8 +269,7 @@ class SplitScreen:
 
     def labels(self, f: int) -> list[tuple]:
         """Every panel's label (and, with 3 variants, the legend in the free cell) as Font.draw_many items."""
-        big = self.size == "10x20"
-        pad_, step_, cell = (8, 21, 10) if big else (4, 13, 6)
+        _, pad_, step_, cell = label_face(self.rects[0][3])
         room = max(2, int(LABEL_SHARE * self.rects[0][3]) // step_)  # a small panel keeps its pendulums in view
         cells = [(rect, shown(self.label_lines(i, f), room)) for i, rect in enumerate(self.rects)]
         if len(self.rects) == 3:

@@ -105,7 +105,7 @@ class _Canvas:
 def _split(src, w: int, h: int, fps: int):
     """A comparison's GIF: a SplitScreen of the GIF's size sharing the video's recorded runs (pass 1 is not run
     again), its panels drawn at the GIF's rate with the video's clock."""
-    from ..draw.split import LARGE, Replay, SplitScreen, layout
+    from ..draw.split import LARGE, Replay, SplitScreen, label_band, layout
 
     class Panel(Replay):
         def next_frame(self, out=None):
@@ -122,7 +122,9 @@ def _split(src, w: int, h: int, fps: int):
             vars(self).update(vars(src))
             self.scene = dataclasses.replace(src.scene, video=dataclasses.replace(src.scene.video, width=w, height=h))
             self.rects = layout(w, h, len(self.runs))
-            self.panels = [Panel(sized(run["scene"], pw, ph), run["q"], run["cert"])
+            # in the video's runtime (the same arch and threads: nothing restarts), adding to its kernel log
+            self.panels = [Panel(sized(run["scene"], pw, ph), run["q"], run["cert"], src.arch, src.threads,
+                                 keep_log=True, keep_clear=[(0, 0, pw - 1, label_band(self.scene, ph) - 1)])
                            for run, (_, _, pw, ph) in zip(self.runs, self.rects)]
             self.buffers = [p.canvas.new_frame() for p in self.panels]
             self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
