@@ -6,9 +6,11 @@ skipped as up to date, or made by `pendulum render`, show too. Links are relativ
 from disk or served from any prefix. Everything taken from metadata is escaped: descriptions are free text.
 
 Each MP4 shows as a <video> with its poster (render/video/poster.py), each card with its certificate (until when
-the video is faithful) and the files' sizes. A small script marks every video and image as it loads or fails
-(data-state), so a broken file says so on its card; tests/test_gallery_browser.py reads those marks from
-headless Chromium. `pendulum gallery` writes the page alone; `pendulum batch` writes it after each batch.
+the video is faithful), the overrides it was made with and the files' sizes; a comparison's card also lists its
+variants, each with when it parts from the finest and until when it is faithful. A small script marks every video
+and image as it loads or fails (data-state), so a broken file says so on its card; tests/test_gallery_browser.py
+reads those marks from headless Chromium. `pendulum gallery` writes the page alone; `pendulum batch` writes it
+after each batch.
 """
 from __future__ import annotations
 
@@ -202,10 +204,11 @@ def _overrides(given) -> str:
     """HTML: each override as given (--quality as quality=LEVEL, then each --set), one per line, escaped."""
     if not isinstance(given, list):
         return "not recorded"  # made before metadata recorded them, or not a list
+    if not given:
+        return "none: the preset as written"
     shown = [f'<code class="set">{_e(_cut(x))}</code>' for x in given[:LISTED] if isinstance(x, str)]
     more = len(given) - LISTED
-    return ("<br>".join(shown) + (f"<br>and {more} more in metadata.json" if more > 0 else "")
-            or "none: the preset as written")
+    return ("<br>".join(shown) or "?") + (f"<br>and {more} more in metadata.json" if more > 0 else "")
 
 
 def _variants(compare: dict, duration) -> str:
