@@ -53,6 +53,12 @@ SKIPPED = {  # folder -> what its card says after "skipped: "
     "compare/evil": "evil is a symlink (to ",
 }
 LONG_NAME = "n" * 300
+# Overrides and a comparison's variants as metadata may hold them: markup, a quote, a non-string, none at all.
+HOSTILE_SETS = ['description="</code><script>alert(1)</script>"', "name='x' onload=\"y\"", 7, None]
+HOSTILE_VARIANTS = [{"label": "<img src=x onerror=alert(2)>", "divergence_s": 0.25,
+                     "faithfulness": {"faithful_until_s": 0.5}},
+                    {"label": "f64 & co", "divergence_s": None, "faithfulness": {"faithful_until_s": 9}},
+                    {"label": ["not", "text"], "divergence_s": "soon", "faithfulness": "always"}, "a string"]
 
 
 def mp4(path: Path):
@@ -81,6 +87,7 @@ def meta_of(name: str, files: dict) -> dict:
             "integrator": {"method": "rk4", "dt": 1e-3, "substeps": 100, "precision": "f64"},
             "faithfulness": {"faithful_until_s": 0.5, "median_until_s": 1.0, "tolerance": 1e-3, "unit": "rad"},
             "energy": {"max_rel_drift": 1e-9}, "timings_s": {"total": 1.5}, "versions": {"package": "x"},
+            "overrides": HOSTILE_SETS, "compare": {"finest": 1, "variants": HOSTILE_VARIANTS},
             "outputs": {f: p.stat().st_size for f, p in files.items()},
             "outputs_sha256": {f: atomic.digest(p) for f, p in files.items()}}
 
@@ -215,6 +222,13 @@ def test_hostile_renders_get_a_card_each_and_nothing_outside_out_is_touched(tmp_
     assert "good &lt;&amp;&gt;" in good and "until 0.50 s (median the end) at 0.001 rad" in good
     assert "rigid, N=3" in good and "10 frames, 64x36 @ 10 fps" in good and "rk4, dt=0.001 s x100, f64" in good
     assert 'src="good_gif/good_gif.gif"' in found["good_gif"]
+    assert "<script" not in page.replace(f"<script>{gallery.SCRIPT}</script>", "") and "<img src=x" not in page
+    assert ('<dd><code class="set">description=&quot;&lt;/code&gt;&lt;script&gt;alert(1)&lt;/script&gt;&quot;</code>'
+            '<br><code class="set">name=&#x27;x&#x27; onload=&quot;y&quot;</code></dd>') in good  # not 7, not null
+    assert ('<dd><span class="variant">&lt;img src=x onerror=alert(2)&gt;: parts from the finest at 0.25 s, faithful '
+            'until 0.50 s</span><br><span class="variant">f64 &amp; co: the one the others part from, faithful until '
+            'the end</span><br><span class="variant">variant 3: parts from the finest at ?, faithful until ?</span>'
+            '<br><span class="variant">variant 4: never parts from the finest, faithful until ?</span></dd>') in good
     assert LONG_NAME in page and "skip" not in found[LONG_NAME]
     assert "skip" not in found["infinite"] and "inf frames" in found["infinite"]
     assert len(found) == 4 + len(SKIPPED)
@@ -289,8 +303,15 @@ def test_an_unwritable_gallery_folder_is_bad_input(tmp_path, folder):
 scalars = st.none() | st.booleans() | st.integers(-10**18, 10**18) | st.floats() | st.text(max_size=20)
 json_values = st.recursive(scalars, lambda kids: st.lists(kids, max_size=4) | st.dictionaries(
     st.text(max_size=12), kids, max_size=4), max_leaves=20)
-sections = st.fixed_dictionaries({}, optional={k: json_values
-                                               for k in (*confined.SECTIONS, "frames", "duration", "fps")})
+variant = st.fixed_dictionaries({}, optional={"label": json_values, "divergence_s": json_values, "faithfulness":
+                                              st.fixed_dictionaries({}, optional={"faithful_until_s": json_values})
+                                              | json_values})
+comparisons = st.fixed_dictionaries({}, optional={"finest": json_values, "variants": st.lists(variant | json_values,
+                                                                                               max_size=4)})
+sections = st.fixed_dictionaries({}, optional={**{k: json_values
+                                                  for k in (*confined.SECTIONS, "frames", "duration", "fps")},
+                                               "overrides": st.lists(json_values, max_size=4) | json_values,
+                                               "compare": comparisons | json_values})
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

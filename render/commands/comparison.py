@@ -14,6 +14,7 @@ renders to OUT/compare/NAME__<short hash>/ unless --name names the folder, as `r
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 from . import batch
@@ -88,7 +89,7 @@ def with_table(scene, vary: dict):
     """The scene with [compare] vary = `vary` (dotted key -> one value per panel), validated as a preset's."""
     raw = scene.to_dict()
     raw["compare"] = {"vary": vary}
-    return from_dict(raw, scene.source)
+    return dataclasses.replace(from_dict(raw, scene.source), overrides=scene.overrides)
 
 
 def run(args) -> int:

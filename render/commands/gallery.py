@@ -6,9 +6,11 @@ skipped as up to date, or made by `pendulum render`, show too. Links are relativ
 from disk or served from any prefix. Everything taken from metadata is escaped: descriptions are free text.
 
 Each MP4 shows as a <video> with its poster (render/video/poster.py), each card with its certificate (until when
-the video is faithful) and the files' sizes. A small script marks every video and image as it loads or fails
-(data-state), so a broken file says so on its card; tests/test_gallery_browser.py reads those marks from
-headless Chromium. `pendulum gallery` writes the page alone; `pendulum batch` writes it after each batch.
+the video is faithful), the overrides it was made with and the files' sizes; a comparison's card also lists its
+variants, each with when it parts from the finest and until when it is faithful. A small script marks every video
+and image as it loads or fails (data-state), so a broken file says so on its card; tests/test_gallery_browser.py
+reads those marks from headless Chromium. `pendulum gallery` writes the page alone; `pendulum batch` writes it
+after each batch.
 """
 from __future__ import annotations
 
@@ -38,6 +40,7 @@ h1{font-weight:600}a{color:#8cf}
 .card h2{font-size:1.1em;margin:.2em 0 .4em;overflow-wrap:anywhere}.desc{color:#aaa}.skip{color:#f88}
 .nogif{padding:3em 0;text-align:center;background:#000;color:#666}
 dl{display:grid;grid-template-columns:auto 1fr;gap:.1em .8em;margin:.6em 0 0}dt{color:#888}dd{margin:0}
+code.set{overflow-wrap:anywhere}
 .failed{background:#3a1616;border-radius:8px;padding:.6em 1em;margin-bottom:1.2em}
 """
 
@@ -56,6 +59,9 @@ for (const el of document.querySelectorAll("video, img")) {
   else if (el.tagName === "VIDEO" ? el.readyState >= 1 : el.complete) ok();
 }
 """
+
+
+LISTED = 40  # overrides or variants a card lists; metadata.json holds them all (and a hostile one, any number)
 
 
 class Found(NamedTuple):
@@ -184,11 +190,50 @@ def card(r: Found, rel: Path) -> str:
         ("versions", " ".join(f"{_cut(k)} {_v(versions, k)}" for k in versions)),
     ]
     desc = _v(preset, "description", default="")
+    items = [(k, _e(v)) for k, v in rows] + [("overrides", _overrides(meta.get("overrides")))]
+    if isinstance(meta.get("compare"), dict):
+        items.append(("variants", _variants(meta["compare"], duration)))
     return (f'<div class="card">{img}<h2>{_e(name)}</h2>'
             + (f'<div class="desc">{_e(desc)}</div>' if desc else "")
             + f"<div>{' &middot; '.join(links)}</div><dl>"
-            + "".join(f"<dt>{_e(k)}</dt><dd>{_e(v)}</dd>" for k, v in rows)
+            + "".join(f"<dt>{_e(k)}</dt><dd>{v}</dd>" for k, v in items)
             + "</dl></div>")
+
+
+def _overrides(given) -> str:
+    """HTML: each override as given (--quality as quality=LEVEL, then each --set), one per line, escaped."""
+    if not isinstance(given, list):
+        return "not recorded"  # made before metadata recorded them, or not a list
+    if not given:
+        return "none: the preset as written"
+    shown = [f'<code class="set">{_e(_cut(x))}</code>' for x in given[:LISTED] if isinstance(x, str)]
+    more = len(given) - LISTED
+    return ("<br>".join(shown) or "?") + (f"<br>and {more} more in metadata.json" if more > 0 else "")
+
+
+def _variants(compare: dict, duration) -> str:
+    """HTML: each variant of a comparison, when it parts from the finest and until when it is faithful."""
+    variants, finest = compare.get("variants"), compare.get("finest")
+    if not isinstance(variants, list):
+        return "not recorded"
+    lines = []
+    for i, v in enumerate(variants[:LISTED]):
+        label = _v(v, "label", default=f"variant {i + 1}")
+        parted = _get(v, "divergence_s")
+        parts = ("the one the others part from" if finest == i and not isinstance(finest, bool) else
+                 "never parts from the finest" if parted is None else
+                 f"parts from the finest at {parted:.2f} s" if _num(parted) != "?" else "parts from the finest at ?")
+        until = _get(v, "faithfulness", "faithful_until_s")
+        lines.append(f'<span class="variant">{_e(label)}: {parts}, faithful until {_until(until, duration)}</span>')
+    more = len(variants) - LISTED
+    return "<br>".join(lines) + (f"<br>and {more} more in metadata.json" if more > 0 else "") or "none"
+
+
+def _until(t, duration) -> str:
+    """A faithful time in words: "the end" when it lasts the video, "?" when not a number."""
+    if _num(t) == "?":
+        return "?"
+    return "the end" if _num(duration) != "?" and t >= duration else f"{t:.2f} s"
 
 
 def _faithful(f, duration) -> str:
@@ -196,9 +241,8 @@ def _faithful(f, duration) -> str:
     first, median, tol = (_get(f, k) for k in ("faithful_until_s", "median_until_s", "tolerance"))
     if _num(first) == "?" or _num(median) == "?":
         return "no certificate"
-    end = duration if _num(duration) != "?" else float("inf")
-    until = [("the end" if t >= end else f"{t:.2f} s") for t in (first, median)]
-    return f"until {until[0]} (median {until[1]}) at {_num(tol)} {_v(f, 'unit', default='')}".rstrip()
+    return (f"until {_until(first, duration)} (median {_until(median, duration)}) at {_num(tol)} "
+            f"{_v(f, 'unit', default='')}").rstrip()
 
 
 def _get(d, *keys):

@@ -127,6 +127,9 @@ class Scene:
     compare: tuple | None = None  # ((dotted key, (value per panel, ...)), ...): a split-screen comparison
     budget: float | None = None  # seconds; how long the run may take, not what it makes: not hashed
     source: str = dataclasses.field(default="", compare=False)
+    # How it was made from its preset, as given: "quality=LEVEL", then each --set, then the API's keyword values,
+    # each a --set argument. Not part of the scene (not hashed): metadata.json's "overrides".
+    overrides: tuple[str, ...] = dataclasses.field(default=(), compare=False)
 
     @property
     def frames(self) -> int:
@@ -144,6 +147,7 @@ class Scene:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
+        d.pop("overrides")
         if self.fractal is None:  # a fan has no map (its [map] is the defaults): it hashes as before maps
             d.pop("fractal")
             d.pop("map")
@@ -197,7 +201,7 @@ class Scene:
                 d[k].update(v)
             else:
                 d[k] = v
-        return from_dict(d, self.source)
+        return dataclasses.replace(from_dict(d, self.source), overrides=self.overrides)
 
 
 # ---------------------------------------------------------------- loading
@@ -225,7 +229,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         _apply_override(raw, *parse_override(item, src), src)
     for key, value in (values or {}).items():
         _apply_override(raw, key.split("."), value, src, how="")
-    return from_dict(raw, src)
+    given = ([f"quality={quality}"] if quality is not None else []) + list(overrides)
+    given += [f"{key}={json.dumps(value)}" for key, value in (values or {}).items()]  # JSON's scalars are TOML's
+    return dataclasses.replace(from_dict(raw, src), overrides=tuple(given))
 
 
 def parse_override(item: str, src: str = "--set") -> tuple[list[str], object]:

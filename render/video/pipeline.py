@@ -227,6 +227,7 @@ def header(scene, arch: str) -> dict:
         "preset": scene.to_dict(),
         "preset_hash": scene.hash(),
         "source": scene.source,
+        "overrides": list(scene.overrides),  # as given: --quality as "quality=LEVEL", then each --set
         "versions": {"package": __version__, "taichi": ".".join(map(str, ti.__version__)),
                      "numpy": np.__version__, "ffmpeg": ffmpeg_version()},
         "arch": arch,
