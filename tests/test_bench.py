@@ -22,6 +22,7 @@ KEYS = ("end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_pea
         "matplotlib_draw_ratio", "peak_gflops.f64", "peak_gflops.f32", "rigid_rk4_peak_fraction.f64",
         "rigid_rk4_peak_fraction.f32")
 TARGETS = {"end_to_end_over_encode_floor", "sim_speedup_vs_numpy_1e5", "fractal_fps.flip_time", "fractal_peak_mem_mb",
+           "fractal_fps.lyapunov",
            "rainbow_1000_draw_fps", "sim_speedup_vs_numba_1e5", "rigid_f64_steps_per_s_1e5",
            "rigid_f32_steps_per_s_1e5", "elastic_speedup_vs_numpy_1e5", "render_over_realtime",
            "matplotlib_peer_ratio", "hud_ms_720p", "matplotlib_draw_ratio", "fractal_fps.divergence",
