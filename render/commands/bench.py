@@ -194,10 +194,10 @@ def phase_sim(cfg, arch, tmp) -> dict:
                         base.step()
                     agree = float(np.abs(sim.q.to_numpy().T - base.q).max())
                 base = Baseline(scene, q0, v0, sim.h)
-                sides = {"taichi": timer(lambda k: (sim.launch(kern, k), ti.sync()), n, cfg["min_s"]),
-                         "numpy": timer(lambda k: [base.step() for _ in range(k)], n, cfg["min_s"])}
+                sides = {"taichi": peers.timer(lambda k: (sim.launch(kern, k), ti.sync()), n, cfg["min_s"]),
+                         "numpy": peers.timer(lambda k: [base.step() for _ in range(k)], n, cfg["min_s"])}
                 if n == 10**5:
-                    nb = peers.numba_timer(scene, q0, v0, sim.h, n, cfg["min_s"], timer)
+                    nb = peers.numba_timer(scene, q0, v0, sim.h, n, cfg["min_s"], peers.timer)
                     sides.update({"numba": nb} if nb else {})
                     if preset == SIM_PRESETS[0]:  # the rigid double pendulum, whose flops peak.py counts
                         sides["peak"] = peak.Peak().timer(cfg["min_s"])
@@ -213,26 +213,6 @@ def phase_sim(cfg, arch, tmp) -> dict:
                     peaks[prec] = {"peak_gflops": med["peak"] / 1e9, "rigid_rk4_gflops": statistics.median(flops) / 1e9,
                                    "flops_per_step": per, "fraction": peers.ratio(flops, runs["peak"])}
     return {"rows": rows, "peak": peaks}
-
-
-def timer(step, n: int, min_s: float):
-    """once(): pendulum-substeps per second of one run of step(k), which advances all n pendulums k substeps;
-    k is chosen here so that a run takes at least min_s (the first call compiles)."""
-    step(1)
-    k = max(1, int(1e4 / n))
-    while True:
-        t = time.perf_counter()
-        step(k)
-        dt = time.perf_counter() - t
-        if dt >= min_s:
-            break
-        k = max(k + 1, int(k * min(20.0, 1.3 * min_s / max(dt, 1e-6))))
-
-    def once() -> float:
-        t = time.perf_counter()
-        step(k)
-        return n * k / (time.perf_counter() - t)
-    return once
 
 
 class Baseline:

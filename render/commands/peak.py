@@ -17,10 +17,10 @@ a multiply and an add (2 flops, as an FMA counts them), the same instructions th
 On AMD Zen (the machines here), whose two multiply and two add pipes issue together, that is the same flop
 rate as FMAs; on a CPU that runs both on its FMA ports it is half the FMA peak.
 """
-import time
 
 import taichi as ti
 
+from . import peers
 from ..physics import runtime
 
 CHAINS, UNROLL = 12, 8
@@ -91,18 +91,4 @@ class Peak:
 
     def timer(self, min_s: float):
         """rate(): flop/s of one run of at least min_s (its iteration count found here; the first run compiles)."""
-        self.run(1)
-        iters = 64
-        while True:
-            t = time.perf_counter()
-            self.run(iters)
-            dt = time.perf_counter() - t
-            if dt >= min_s:
-                break
-            iters = max(iters + 1, int(iters * min(20.0, 1.3 * min_s / max(dt, 1e-6))))
-
-        def rate() -> float:
-            t = time.perf_counter()
-            self.run(iters)
-            return self.flops(iters) / (time.perf_counter() - t)
-        return rate
+        return peers.timer(self.run, self.flops(1), min_s)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import statistics
+import time
 
 try:
     import numba
@@ -164,6 +165,27 @@ def spreads(rows: list[dict], mpl: dict | None = None) -> dict:
     if mpl:
         out["matplotlib_peer_ratio"], out["matplotlib_draw_ratio"] = mpl["vs"]["render"], mpl["vs"]["draw"]
     return out
+
+
+def timer(step, n: int, min_s: float):
+    """once(): work per second of one run of step(k), which does k steps of n units of work each (n pendulums'
+    substeps, or flops); k is chosen here so that a run takes at least min_s (the first call compiles). The
+    bench's kernels, its numpy and numba peers and the peak rate are all timed by it."""
+    step(1)
+    k = max(1, int(1e4 / n))
+    while True:
+        t = time.perf_counter()
+        step(k)
+        dt = time.perf_counter() - t
+        if dt >= min_s:
+            break
+        k = max(k + 1, int(k * min(20.0, 1.3 * min_s / max(dt, 1e-6))))
+
+    def once() -> float:
+        t = time.perf_counter()
+        step(k)
+        return n * k / (time.perf_counter() - t)
+    return once
 
 
 def numba_timer(scene, q, v, h: float, n: int, min_s: float, timer):
