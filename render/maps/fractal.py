@@ -105,10 +105,9 @@ class Map(runtime.Launcher):
 
     COLOUR = "fractal_colour"  # the kernel that colours the pixels; a subclass's map names its own
 
-    def __init__(self, scene, sim, cert):
+    def __init__(self, scene, sim, cert, rows: range | None = None):
         v, self.scene, self.sim, self.kind = scene.video, scene, sim, scene.fractal
-        self.lay = grid.layout(v.width, v.height)
-        self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.place(rows)
         self.twins = self.kind == "divergence"
         self.lanes = 2 if self.twins else 1  # pendulums per kernel iteration: a pixel, or a pixel and its twin
         self.groups = -(-sim.n // self.lanes)
@@ -118,11 +117,25 @@ class Map(runtime.Launcher):
         self.log_lo, self.log_span = math.log(self.lo), math.log(self.hi / self.lo)
         self.log_ratio = math.log(self.threshold / self.eps)
         self.event = runtime.field("fractal.event", ti.f32, self.pixels)
-        self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
-        self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
+        self.until = self.faithful(cert)
         self.font = Font(self.lay.font) if self.lay.font else None
         self.background = self.decorate()
         self.restart()
+
+    def place(self, rows: range | None):
+        """The plot, and the band of its rows this map integrates and colours: all of them, or one tile's
+        (render/maps/tiles.py: the system then holds only the band's pendulums)."""
+        self.lay = grid.layout(self.scene.video.width, self.scene.video.height)
+        self.rows = range(self.lay.h) if rows is None else rows
+        self.w, self.h, self.r0 = self.lay.w, len(self.rows), self.rows.start
+        self.pixels = self.w * self.h
+
+    def faithful(self, cert):
+        """The band's per-pixel faithful times (grid.faithful_map), as a field."""
+        until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
+        band = grid.faithful_map(self.scene, cert.until_s)[self.rows.start:self.rows.stop]
+        until.from_numpy(band.ravel().astype(np.float32))
+        return until
 
     def restart(self):
         """Every event pending again (or never, below the barrier), from the system's current (initial) state."""
@@ -152,15 +165,23 @@ class Map(runtime.Launcher):
             self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")
         return out
 
+    def arrays(self) -> dict:
+        """Per pixel of the band, what summary() counts: a tile's are joined row-wise (render/maps/tiles.py)."""
+        return {"event": self.event.to_numpy(), "until": self.until.to_numpy()}
+
     def summary(self) -> dict:
-        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not."""
-        ev, until = self.event.to_numpy(), self.until.to_numpy()
-        t = np.float32(self.sim.t)
+        return self.summarise(self.scene, self.arrays(), self.sim.t)
+
+    @staticmethod
+    def summarise(scene, a: dict, t: float) -> dict:
+        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not, at
+        time t, from arrays() (a map's own, or its tiles' joined)."""
+        ev, until = a["event"], a["until"]
         done, pending = ev >= 0, ev == PENDING
-        claim = np.where(done, ev, t)
-        lay, stride = self.lay, self.scene.map.trust_stride
-        return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
-                "pixels": self.pixels, "time_scale_s": [self.lo, self.hi],
+        claim = np.where(done, ev, np.float32(t))
+        lay, stride = grid.layout(scene.video.width, scene.video.height), scene.map.trust_stride
+        return {"colouring": scene.fractal, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "pixels": len(ev), "time_scale_s": list(time_scale(scene.video.duration)),
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
                 "cannot_flip": int((ev == NEVER).sum()), "events": int(done.sum()),
@@ -307,9 +328,9 @@ class Map(runtime.Launcher):
                 else:
                     col = ti.Vector([PENDING_GREY] * 3)
             if claim > self.until[p]:
-                col = untrusted(col, c, r)
+                col = untrusted(col, c, self.r0 + r)  # the hatch of the whole plot, whichever band this is
             for k in ti.static(range(3)):
-                out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+                out[self.lay.y0 + self.r0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
 
     @ti.kernel
     def fractal_swatch(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), x0: ti.i32, y0: ti.i32, w: ti.i32,

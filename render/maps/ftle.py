@@ -58,11 +58,10 @@ class FtleMap(fractal.Map):
 
     COLOUR = "ftle_colour"
 
-    def __init__(self, scene, sim, cert):
+    def __init__(self, scene, sim, cert, rows: range | None = None):
         check_method(scene)
         self.scene, self.sim, self.kind = scene, sim, scene.fractal
-        self.lay = grid.layout(scene.video.width, scene.video.height)
-        self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.place(rows)
         self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
         self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
         self.twin = libm_twin(sim)
@@ -77,8 +76,7 @@ class FtleMap(fractal.Map):
         self.log_scale = runtime.field("ftle.log_scale", real, self.pixels)  # L
         self.sigma = runtime.field("ftle.sigma", real, self.pixels)  # σ_t as last drawn
         self.edge = runtime.field("ftle.barrier", ti.u8, self.pixels)
-        self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
-        self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
+        self.until = self.faithful(cert)
         self.barrier = min(fractal.barriers(sim.masses, sim.lengths, sim.g))
         self.edge.from_numpy(self.barrier_curve())
         self.font = Font(self.lay.font) if self.lay.font else None
@@ -112,18 +110,24 @@ class FtleMap(fractal.Map):
         m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
         return m, self.log_scale.to_numpy().astype(np.float64)
 
-    def summary(self) -> dict:
-        """For metadata.json: the plot, the lattice, σ's spread and how many pixels are trusted."""
-        sig, until = self.sigma.to_numpy(), self.until.to_numpy()
-        trusted = np.float32(self.sim.t) <= until
-        lay, stride = self.lay, self.scene.map.trust_stride
-        q = np.percentile(sig, [5, 50, 95]).tolist() if self.sim.t > 0 else [0.0] * 3
-        return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
-                "pixels": self.pixels, "sigma_scale_per_s": [self.lo, self.hi],
+    def arrays(self) -> dict:
+        """Per pixel of the band, what summary() counts (fractal.Map.arrays)."""
+        return {"sigma": self.sigma.to_numpy(), "until": self.until.to_numpy(), "edge": self.edge.to_numpy()}
+
+    @staticmethod
+    def summarise(scene, a: dict, t: float) -> dict:
+        """For metadata.json: the plot, the lattice, σ's spread and how many pixels are trusted at time t, from
+        arrays() (fractal.Map.summarise)."""
+        sig, until = a["sigma"], a["until"]
+        trusted = np.float32(t) <= until
+        lay, stride = grid.layout(scene.video.width, scene.video.height), scene.map.trust_stride
+        q = np.percentile(sig, [5, 50, 95]).tolist() if t > 0 else [0.0] * 3
+        return {"colouring": scene.fractal, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "pixels": len(sig), "sigma_scale_per_s": [0.0, SIGMA_MAX],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
-                "t_s": self.sim.t, "sigma_percentiles_5_50_95_per_s": q, "trusted": int(trusted.sum()),
-                "barrier_pixels": int(self.edge.to_numpy().sum())}
+                "t_s": t, "sigma_percentiles_5_50_95_per_s": q, "trusted": int(trusted.sum()),
+                "barrier_pixels": int(a["edge"].sum())}
 
     # ------------------------------------------------------------ kernels
     @ti.kernel
@@ -205,6 +209,6 @@ class FtleMap(fractal.Map):
             if self.edge[p]:
                 col = ti.Vector([0.0, 0.0, 0.0])
             if t > self.until[p]:
-                col = fractal.untrusted(col, c, r)
+                col = fractal.untrusted(col, c, self.r0 + r)
             for k in ti.static(range(3)):
-                out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+                out[self.lay.y0 + self.r0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)

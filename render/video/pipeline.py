@@ -69,11 +69,8 @@ class Source:
         self.run = Run(self.scene, arch, threads)
         self.arch, self.sim = self.run.arch, self.run.sim
         if self.scene.fractal:
-            if self.scene.fractal == "lyapunov":
-                from ..maps.ftle import FtleMap as Map  # it carries each pixel's tangent vectors through the frame
-            else:
-                from ..maps.fractal import Map
-            self.canvas = Map(self.scene, self.sim, self.cert)  # it advances the pixels too: events per substep
+            from ..maps.tiles import map_class
+            self.canvas = map_class(self.scene)(self.scene, self.sim, self.cert)  # it advances the pixels too
         else:
             from ..draw.canvas import Canvas
             from ..draw.hud import Info
@@ -125,8 +122,12 @@ def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
             "kernels": list(runtime.launched), "fields": dict(runtime.allocated)}
 
 
-def open_source(scene, arch: str = "cpu", threads: int | None = None):
-    """What `render` encodes and `show` plays: the scene's Source, or a comparison's split screen."""
+def open_source(scene, arch: str = "cpu", threads: int | None = None, cluster=None, bands: int | None = None):
+    """What `render` encodes and `show` plays: the scene's Source, a comparison's split screen, or with a Dask
+    `cluster` (a Client) a map's frames made in `bands` tiles there (render/video/tiled.py)."""
+    if cluster is not None:
+        from .tiled import TiledSource
+        return TiledSource(scene, cluster, bands, arch, threads)
     if not scene.compare:
         return Source(scene, arch, threads)
     from ..draw.split import SplitScreen
@@ -134,14 +135,14 @@ def open_source(scene, arch: str = "cpu", threads: int | None = None):
 
 
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
-           frame_hook=None) -> dict:
+           frame_hook=None, cluster=None, bands: int | None = None) -> dict:
     """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
-    wrote. frame_hook(f, frame) sees raw frames."""
+    wrote. frame_hook(f, frame) sees raw frames. cluster, bands: a map in tiles on Dask (open_source)."""
     from .encode import Encoder
     from .gif import Frames
 
     t_start = time.perf_counter()
-    src = open_source(scene, arch, threads)  # may refuse (exit 2 or 1) before anything is written
+    src = open_source(scene, arch, threads, cluster, bands)  # may refuse (exit 2 or 1) before anything is written
     scene, timings = src.scene, src.timings
     timings["encode"] = 0.0
     voices = None

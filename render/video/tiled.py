@@ -1,0 +1,134 @@
+"""One map across a Dask cluster (`render MAP --scheduler ADDR` or `--tiles N`): its bands integrated by Dask
+workers (render/maps/tiles.py), its frames put together here and encoded as a local render's are: the same
+bytes, frame for frame.
+
+The certificate runs once, here, before any task, and every band gets it. A band's task is keyed by the
+scene's hash (pendulum-tile-<hash>-<band>-of-<bands>-<nonce>) and its result names the scene it drew, which is
+checked: a band of another scene is an error, never part of a frame. A band whose worker dies is run again by
+the scheduler on another worker (up to its distributed.scheduler.allowed-failures), one that raised up to
+RETRIES more times; a band that cannot be had fails the render before anything is written (exit 1).
+
+Dask's client and the cluster's addresses are made here, for `batch --scheduler` (whole presets as tasks,
+render/commands/batch.py) too.
+"""
+from __future__ import annotations
+
+import os
+import re
+import time
+from contextlib import contextmanager
+
+from ..errors import BatchError, SceneError
+from ..maps import tiles
+from ..physics import grid, registry, runtime
+
+RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
+
+
+def scheduler_address(text: str | None) -> str | None:
+    """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client."""
+    if not text:
+        return None
+    address = text if "://" in text else f"tcp://{text}"
+    # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
+    # raise in a background thread and hang)
+    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
+    port = m and m.group(3)
+    if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
+        raise SceneError(f"--scheduler {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
+    return address
+
+
+def connect(address: str):
+    """A Client of the Dask scheduler at `address`; BatchError (exit 1) when it cannot be reached."""
+    from dask.distributed import Client
+    try:
+        return Client(address, timeout="10s", set_as_default=False)
+    except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...)
+        raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
+
+
+def check(scene, how: str):
+    """Bad input before any work: a tiled render of a scene that is not a map, or of a map whose extras
+    (energy, audio) read the whole system in one process."""
+    if not scene.fractal:
+        raise SceneError(f"{scene.source}: {how} splits a map (effects = [\"fractal\"]) into tiles; this preset is "
+                         f"not one (render it without {how.split()[0]})")
+    extra = [e for e in ("energy", "audio") if scene.has(e)]
+    if extra:
+        raise SceneError(f"{scene.source}: effects: {extra[0]!r} is measured over the whole system in one process; "
+                         f"a tiled map ({how}) cannot take it")
+
+
+@contextmanager
+def cluster(address: str | None, workers: int | None):
+    """A Client: of the scheduler at `address`, or of a LocalCluster of `workers` single-threaded worker
+    processes on loopback, closed after the block."""
+    if address:
+        client = connect(address)
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    import logging
+    from dask.distributed import Client, LocalCluster
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None, silence_logs=logging.ERROR) as local, \
+            Client(local, set_as_default=False) as client:
+        yield client
+
+
+class TiledSource:
+    """The frames of a map whose bands Dask workers made: what pipeline.render encodes, as it does a Source's.
+
+    bands: how many (default: one per worker thread of the cluster); threads: Taichi threads per band."""
+
+    def __init__(self, scene, client, bands: int | None = None, arch: str = "cpu", threads: int | None = None):
+        from .pipeline import prepare  # pipeline imports this module only when a render is tiled
+
+        self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
+        scene = self.scene
+        self.sim = registry.get(scene.system)(scene, allocate=False)  # its step, for metadata; nothing allocated
+        self.name, self.frames, self.index = scene.name, scene.frames, -1
+        lay = grid.layout(scene.video.width, scene.video.height)
+        rows = tiles.bands(lay.h, bands or sum(client.nthreads().values()) or 1)
+        nonce, digest = os.urandom(4).hex(), scene.hash()
+        t = time.perf_counter()
+        futures = [client.submit(tiles.render_band, scene, r, self.cert, arch, threads, pure=False, retries=RETRIES,
+                                 key=f"pendulum-tile-{digest[:16]}-{i}-of-{len(rows)}-{nonce}")
+                   for i, r in enumerate(rows)]
+        try:
+            results = client.gather(futures)
+        except (SceneError, BatchError, RuntimeError):  # the watchdog's SimulationError among them
+            raise
+        except Exception as e:  # noqa: BLE001 - e.g. KilledWorker: a band's workers kept dying
+            raise BatchError(f"{scene.name}: a tile could not be rendered on the cluster: {type(e).__name__}: "
+                             f"{e}") from None
+        finally:
+            client.cancel(futures)  # a no-op for finished bands; stops the others when one failed
+        if any(r["scene_hash"] != digest for r in results):
+            raise BatchError(f"{scene.name}: a tile of another scene came back from the cluster; nothing was written")
+        self.arch = results[0]["arch"]
+        self.timings = {**before, "simulate": time.perf_counter() - t, "draw": 0.0}  # on the cluster: both
+        self.tiles = {"bands": len(rows), "workers": len(client.nthreads()),
+                      "band_rows": [list(r["rows"]) for r in results],
+                      "band_timings_s": [{k: round(v, 4) for k, v in r["timings"].items()} for r in results]}
+        runtime.launched[:] = results[0]["kernels"]  # what metadata lists: a band's kernels, all bands' fields
+        runtime.allocated.clear()
+        for r in results:
+            for name, size in r["fields"].items():
+                runtime.allocated[name] = runtime.allocated.get(name, 0) + size
+        self.assembly = tiles.Assembly(scene, results)
+        self.canvas = self  # what pipeline.render asks a map's canvas for: summary()
+
+    def summary(self) -> dict:
+        return {**self.assembly.summary(), "tiles": self.tiles}
+
+    def next_frame(self, out=None):
+        """The next frame as H×W×3 uint8, put together from the bands."""
+        self.index += 1
+        t = time.perf_counter()
+        frame = self.assembly.frame(self.index, out)
+        self.timings["draw"] += time.perf_counter() - t
+        return frame
