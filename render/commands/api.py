@@ -20,7 +20,8 @@ from . import comparison
 from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
-from ..config.options import check_arch, check_out_folder, check_replaceable, check_threads, check_writable
+from ..config.options import (check_arch, check_out_folder, check_replaceable, check_threads, check_tiles,
+                              check_writable)
 from .results import RenderResult, Trajectory
 
 
@@ -61,11 +62,14 @@ def _scene(scene) -> scenes.Scene:
     return scene if isinstance(scene, scenes.Scene) else load(scene)
 
 
-def check_render(scene_list, out: Path) -> None:
+def check_render(scene_list, out: Path, tiled: str | None = None) -> None:
     """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder), a
-    scene over the budget."""
+    scene over the budget, or with `tiled` (the option asking for it) one that cannot be rendered in tiles."""
     out = Path(out)
     for scene in scene_list:
+        if tiled:
+            from ..video import tiled as tiling
+            tiling.check(scene, tiled)
         check_out_folder(scene, out)
         if scene.has("lyapunov"):  # an integrator with no tangent map, too few frames for the error
             from ..trust import lyapunov
@@ -74,13 +78,27 @@ def check_render(scene_list, out: Path) -> None:
 
 
 def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads: int | None = None,
-           progress: bool = False) -> RenderResult:
+           progress: bool = False, scheduler: str | None = None, tiles: int | None = None) -> RenderResult:
     """Render a Scene (or a preset name) into OUT/NAME/: MP4 and GIF as the scene's formats say, and
-    metadata.json. Returns the paths, the metadata and the faithfulness certificate."""
+    metadata.json. Returns the paths, the metadata and the faithfulness certificate.
+
+    A map in tiles on Dask, the same bytes: `scheduler` (an address, as --scheduler takes it) and `tiles`
+    bands (default: one per worker thread), or `tiles` alone: a local cluster of that many worker processes."""
+    from ..video import tiled
+
     scene = _scene(scene)
     arch, threads, out = check_arch(arch), check_threads(threads), Path(out)
-    check_render([scene], out)
-    meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
+    address, tiles = tiled.scheduler_address(scheduler), check_tiles(tiles)
+    how = "--scheduler" if address else "--tiles" if tiles else None
+    check_render([scene], out, how)
+    if not how:
+        meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
+    else:
+        if not address and threads is None:  # the local workers share the cores
+            threads = max(1, len(os.sched_getaffinity(0)) // tiles) if hasattr(os, "sched_getaffinity") else None
+        with tiled.cluster(address, tiles) as client:
+            meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads, cluster=client,
+                                   bands=tiles)
     return RenderResult(scene, scene.out_dir(out), meta)
 
 

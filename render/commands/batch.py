@@ -29,6 +29,7 @@ from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_writable, output_name, positive_int,
                       progress_wanted, thread_count)
 from ..config.scene import SCHEMA, list_presets, load, parse_override, preset_path
+from ..video.tiled import connect, scheduler_address
 from ..video.version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -237,27 +238,10 @@ def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def scheduler_address(text: str | None) -> str | None:
-    """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client."""
-    if not text:
-        return None
-    address = text if "://" in text else f"tcp://{text}"
-    # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
-    # raise in a background thread and hang)
-    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
-    port = m and m.group(3)
-    if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
-        raise SceneError(f"--scheduler {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
-    return address
-
-
 def run_dask(scenes, out_root, address, arch, threads, digest):
     """Yield result rows as Dask tasks finish; outputs are written by the workers into out_root."""
-    from dask.distributed import Client, as_completed
-    try:
-        client = Client(address, timeout="10s", set_as_default=False)
-    except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...), no batch
-        raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
+    from dask.distributed import as_completed
+    client = connect(address)
     futs = {}
     try:
         for s in scenes:

@@ -15,7 +15,8 @@ import traceback
 from pathlib import Path
 
 from ..errors import BatchError, EncodeError, SceneError, SimulationError
-from ..config.options import add_budget, add_common, add_quality, add_render_options, budgeted, output_name, progress_wanted
+from ..config.options import (add_budget, add_common, add_quality, add_render_options, add_tiles, budgeted, output_name,
+                              progress_wanted)
 
 # Subcommands living in their own modules: command -> (module, the line `pendulum --help` lists it with). Each
 # module has add_parser(subparsers) and run(args) -> exit code. Only the module of the command given is imported:
@@ -60,6 +61,7 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
                                    "OUT/compare/NAME/ (see `pendulum compare`).")
     r.add_argument("presets", nargs="+", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_render_options(r)
+    add_tiles(r)
     r.set_defaults(func=cmd_render)
 
     s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",
@@ -89,16 +91,22 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
 def cmd_render(args) -> int:
     from . import api
     from ..config import budget
+    from ..video.tiled import scheduler_address
 
+    address = scheduler_address(args.scheduler)  # a bad one before any work
     scenes = [budgeted(api.load(p, *args.overrides, quality=args.quality), args) for p in args.presets]  # all first
     if args.name and len(scenes) > 1:
         raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
     overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
     scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
-    api.check_render(scenes, args.out)  # every scene's refusals before the first render
+    tiled = "--scheduler" if address else "--tiles" if args.tiles else None
+    api.check_render(scenes, args.out, tiled)  # every scene's refusals before the first render
     budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
     for scene in scenes:
-        result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
+        # as for `batch`, Dask's own variable names the cluster: for the maps, which alone can be tiled
+        scheduler = address or (os.environ.get("DASK_SCHEDULER_ADDRESS") if scene.fractal else None)
+        result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads,
+                            scheduler=scheduler, tiles=args.tiles)
         print(result.line())
     return 0
 

@@ -48,6 +48,16 @@ def add_render_options(p):
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+def add_tiles(p):
+    """`render`'s map in tiles over a Dask cluster (render/video/tiled.py)."""
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="render a map in tiles on this Dask scheduler, e.g. tcp://host:8786 (default for a map: "
+                        "$DASK_SCHEDULER_ADDRESS); byte-identical to the local render")
+    p.add_argument("--tiles", type=positive_int, metavar="N",
+                   help="split a map into N bands of rows; without --scheduler, rendered on a local cluster of N "
+                        "worker processes (default with --scheduler: one band per worker thread)")
+
+
 def add_quality(p):
     p.add_argument("--quality", choices=LEVELS,
                    help="a guarantee instead of the preset's integrator: the median pendulum stays faithful for "
@@ -131,6 +141,17 @@ def check_arch(arch) -> str:
     if not isinstance(arch, str) or arch not in ARCHES:
         raise SceneError(f"arch={clip(repr(arch))}: must be one of {', '.join(ARCHES)}")
     return arch
+
+
+def check_tiles(tiles) -> int | None:
+    """The API's tiles=: None or what --tiles accepts (SceneError otherwise)."""
+    from .validate import clip
+
+    if tiles is None:
+        return None
+    if isinstance(tiles, bool) or not isinstance(tiles, numbers.Integral) or tiles < 1:
+        raise SceneError(f"tiles={clip(repr(tiles))}: must be a positive integer, or None")
+    return int(tiles)
 
 
 def check_threads(threads) -> int | None:

@@ -127,7 +127,7 @@ def open_source(scene, arch: str = "cpu", threads: int | None = None, cluster=No
     `cluster` (a Client) a map's frames made in `bands` tiles there (render/video/tiled.py)."""
     if cluster is not None:
         from .tiled import TiledSource
-        return TiledSource(scene, cluster, bands, arch, threads)
+        return TiledSource(prepare(scene, arch, threads), cluster, bands, arch, threads)
     if not scene.compare:
         return Source(scene, arch, threads)
     from ..draw.split import SplitScreen

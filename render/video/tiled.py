@@ -9,7 +9,7 @@ the scheduler on another worker (up to its distributed.scheduler.allowed-failure
 RETRIES more times; a band that cannot be had fails the render before anything is written (exit 1).
 
 Dask's client and the cluster's addresses are made here, for `batch --scheduler` (whole presets as tasks,
-render/commands/batch.py) too.
+render/commands/batch.py) too; so this module imports neither Taichi nor Dask until a render starts.
 """
 from __future__ import annotations
 
@@ -19,8 +19,6 @@ import time
 from contextlib import contextmanager
 
 from ..errors import BatchError, SceneError
-from ..maps import tiles
-from ..physics import grid, registry, runtime
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
 
@@ -82,12 +80,15 @@ def cluster(address: str | None, workers: int | None):
 class TiledSource:
     """The frames of a map whose bands Dask workers made: what pipeline.render encodes, as it does a Source's.
 
-    bands: how many (default: one per worker thread of the cluster); threads: Taichi threads per band."""
+    prepared: what pipeline.prepare() gave (the scene as run, `chosen`, the certificate, its timings); bands: how
+    many (default: one per worker thread of the cluster); threads: Taichi threads per band."""
 
-    def __init__(self, scene, client, bands: int | None = None, arch: str = "cpu", threads: int | None = None):
-        from .pipeline import prepare  # pipeline imports this module only when a render is tiled
+    def __init__(self, prepared: tuple, client, bands: int | None = None, arch: str = "cpu",
+                 threads: int | None = None):
+        from ..maps import tiles
+        from ..physics import grid, registry, runtime
 
-        self.scene, self.chosen, self.cert, before = prepare(scene, arch, threads)
+        self.scene, self.chosen, self.cert, before = prepared
         scene = self.scene
         self.sim = registry.get(scene.system)(scene, allocate=False)  # its step, for metadata; nothing allocated
         self.name, self.frames, self.index = scene.name, scene.frames, -1
@@ -123,6 +124,7 @@ class TiledSource:
         self.canvas = self  # what pipeline.render asks a map's canvas for: summary()
 
     def summary(self) -> dict:
+        """The map's summary() of the whole plot, and how its tiles were made."""
         return {**self.assembly.summary(), "tiles": self.tiles}
 
     def next_frame(self, out=None):
