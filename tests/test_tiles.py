@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import io
+import json
 import os
 import signal
 import socket
@@ -110,11 +111,12 @@ def test_a_worker_killed_mid_render_is_retried(cluster, local, tmp_path):
     c, client = cluster
     client.wait_for_workers(2, timeout=60)
     pids = client.run(os.getpid)  # worker address -> its process
-    killed, stop = [], threading.Event()
+    killed, seen, stop = [], set(), threading.Event()
 
     def killer():
         while not stop.is_set() and not killed:
             for worker, keys in client.processing().items():
+                seen.update(str(k) for k in keys)
                 if any(str(k).startswith("pendulum-tile-") for k in keys) and worker in pids:
                     os.kill(pids[worker], signal.SIGKILL)
                     killed.append(worker)
@@ -134,6 +136,8 @@ def test_a_worker_killed_mid_render_is_retried(cluster, local, tmp_path):
     if code == 0:
         (mp4,) = tmp_path.glob("fractal_flip__*/*.mp4")  # --set: the folder NAME__<hash>
         assert mp4.read_bytes() == (folder / "fractal_flip.mp4").read_bytes()
+        digest = json.loads((mp4.parent / "metadata.json").read_text())["preset_hash"]
+        assert all(k.startswith(f"pendulum-tile-{digest[:16]}-") for k in seen)  # the tasks name their scene
     else:  # the other way the brief allows: one clear line, nothing written
         assert code == 1 and err.count("\n") == 1 and "tile" in err, err
         assert not list(tmp_path.iterdir())

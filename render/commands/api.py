@@ -83,7 +83,8 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
     metadata.json. Returns the paths, the metadata and the faithfulness certificate.
 
     A map in tiles on Dask, the same bytes: `scheduler` (an address, as --scheduler takes it) and `tiles`
-    bands (default: one per worker thread), or `tiles` alone: a local cluster of that many worker processes."""
+    bands (default: one per worker thread), or `tiles` alone: that many bands on a local cluster of as many
+    worker processes (at most one a core), which share the cores."""
     from ..video import tiled
 
     scene = _scene(scene)
@@ -94,9 +95,11 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
     if not how:
         meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
     else:
-        if not address and threads is None:  # the local workers share the cores
-            threads = max(1, len(os.sched_getaffinity(0)) // tiles) if hasattr(os, "sched_getaffinity") else None
-        with tiled.cluster(address, tiles) as client:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        workers = None if address else min(tiles, cores)
+        if workers and threads is None:
+            threads = max(1, cores // workers)
+        with tiled.cluster(address, workers) as client:
             meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads, cluster=client,
                                    bands=tiles)
     return RenderResult(scene, scene.out_dir(out), meta)

@@ -55,7 +55,7 @@ def add_tiles(p):
                         "$DASK_SCHEDULER_ADDRESS); byte-identical to the local render")
     p.add_argument("--tiles", type=positive_int, metavar="N",
                    help="split a map into N bands of rows; without --scheduler, rendered on a local cluster of N "
-                        "worker processes (default with --scheduler: one band per worker thread)")
+                        "worker processes, at most one a core (default with --scheduler: one band per worker thread)")
 
 
 def add_quality(p):

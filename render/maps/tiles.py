@@ -21,6 +21,7 @@ import zlib
 
 import numpy as np
 
+from ..errors import SimulationError
 from ..physics import grid, runtime
 from ..physics.stepper import Run
 
@@ -50,7 +51,15 @@ def render_band(scene, rows: range, cert, arch: str = "cpu", threads: int | None
     Returns `scene_hash` (the client checks it: a band of another scene is never put into this one), `rows`,
     `frames` (per frame the compressed XOR delta, see the module's docstring) of an array of `shape`, `arrays`
     (the map's per-pixel arrays() of the band at the end), `t` (the clock at the end), `arch`, `kernels`,
-    `fields` and `timings` (simulate, draw, compress: seconds)."""
+    `fields` and `timings` (simulate, draw, compress: seconds). The watchdog's SimulationError comes back as
+    `error`, not raised: it would fail the same way again, and Dask reruns what raises."""
+    try:
+        return _band(scene, rows, cert, arch, threads)
+    except SimulationError as e:
+        return {"scene_hash": scene.hash(), "rows": (rows.start, rows.stop), "error": str(e)}
+
+
+def _band(scene, rows: range, cert, arch: str, threads: int | None) -> dict:
     lay = grid.layout(scene.video.width, scene.video.height)
     halo = HALO if scene.fractal == "lyapunov" else 0
     span = range(max(rows.start - halo, 0), min(rows.stop + halo, lay.h))
@@ -90,7 +99,7 @@ class Assembly:
         """Frame f (after frame f - 1: each band's frame is a delta on its previous one)."""
         for i, r in enumerate(self.results):
             part = np.frombuffer(zlib.decompress(r["frames"][f]), np.uint8).reshape(r["shape"])
-            self.last[i] = part.copy() if f == 0 else part ^ self.last[i]
+            self.last[i] = part if f == 0 else part ^ self.last[i]
         if out is None:
             out = np.empty_like(self.last[0])
         np.copyto(out, self.last[0])  # the top band: the whole frame

@@ -5,8 +5,10 @@ bytes, frame for frame.
 The certificate runs once, here, before any task, and every band gets it. A band's task is keyed by the
 scene's hash (pendulum-tile-<hash>-<band>-of-<bands>-<nonce>) and its result names the scene it drew, which is
 checked: a band of another scene is an error, never part of a frame. A band whose worker dies is run again by
-the scheduler on another worker (up to its distributed.scheduler.allowed-failures), one that raised up to
-RETRIES more times; a band that cannot be had fails the render before anything is written (exit 1).
+the scheduler on another worker (up to its distributed.scheduler.allowed-failures), one that raised (say, out
+of memory) up to RETRIES more times; the watchdog's verdict is a result, not raised, since it would come again.
+A band that cannot be had fails the render at once, its other bands cancelled, before anything is written
+(exit 1).
 
 Dask's client and the cluster's addresses are made here, for `batch --scheduler` (whole presets as tasks,
 render/commands/batch.py) too; so this module imports neither Taichi nor Dask until a render starts.
@@ -18,7 +20,7 @@ import re
 import time
 from contextlib import contextmanager
 
-from ..errors import BatchError, SceneError
+from ..errors import BatchError, SceneError, SimulationError
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
 
@@ -99,15 +101,7 @@ class TiledSource:
         futures = [client.submit(tiles.render_band, scene, r, self.cert, arch, threads, pure=False, retries=RETRIES,
                                  key=f"pendulum-tile-{digest[:16]}-{i}-of-{len(rows)}-{nonce}")
                    for i, r in enumerate(rows)]
-        try:
-            results = client.gather(futures)
-        except (SceneError, BatchError, RuntimeError):  # the watchdog's SimulationError among them
-            raise
-        except Exception as e:  # noqa: BLE001 - e.g. KilledWorker: a band's workers kept dying
-            raise BatchError(f"{scene.name}: a tile could not be rendered on the cluster: {type(e).__name__}: "
-                             f"{e}") from None
-        finally:
-            client.cancel(futures)  # a no-op for finished bands; stops the others when one failed
+        results = self.collect(futures, client)
         if any(r["scene_hash"] != digest for r in results):
             raise BatchError(f"{scene.name}: a tile of another scene came back from the cluster; nothing was written")
         self.arch = results[0]["arch"]
@@ -122,6 +116,26 @@ class TiledSource:
                 runtime.allocated[name] = runtime.allocated.get(name, 0) + size
         self.assembly = tiles.Assembly(scene, results)
         self.canvas = self  # what pipeline.render asks a map's canvas for: summary()
+
+    def collect(self, futures: list, client) -> list[dict]:
+        """The bands' results, top first, as they finish; the first failure cancels the others and raises."""
+        from dask.distributed import as_completed
+
+        index = {f.key: i for i, f in enumerate(futures)}
+        results = [None] * len(futures)
+        try:
+            for fut in as_completed(futures):
+                try:
+                    r = fut.result()
+                except Exception as e:  # noqa: BLE001 - e.g. KilledWorker: a band's workers kept dying
+                    raise BatchError(f"{self.scene.name}: a tile could not be rendered on the cluster: "
+                                     f"{type(e).__name__}: {e}") from None
+                if "error" in r:
+                    raise SimulationError(r["error"])
+                results[index[fut.key]] = r
+        finally:
+            client.cancel(futures)  # a no-op for finished bands; stops the others when one failed
+        return results
 
     def summary(self) -> dict:
         """The map's summary() of the whole plot, and how its tiles were made."""
