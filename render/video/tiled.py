@@ -124,7 +124,7 @@ class TiledSource:
         index = {f.key: i for i, f in enumerate(futures)}
         results = [None] * len(futures)
         try:
-            for fut in as_completed(futures):
+            for fut in as_completed(futures, loop=client.loop):
                 try:
                     r = fut.result()
                 except Exception as e:  # noqa: BLE001 - e.g. KilledWorker: a band's workers kept dying
