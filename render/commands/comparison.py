@@ -18,6 +18,7 @@ import dataclasses
 from pathlib import Path
 
 from . import batch
+from ..trust import faithful
 from ..video import pipeline
 from ..errors import SceneError
 from ..config.options import add_render_options, budgeted, check_out_folder, output_name, progress_wanted
@@ -117,8 +118,9 @@ def summary(meta: dict, out_dir: Path) -> str:
             how = "finest"
         else:
             how = "never parts" if v["divergence_s"] is None else f"parts at {v['divergence_s']:.2f} s"
+        until = faithful.until(v["faithfulness"]["faithful_until_s"], meta["duration"])
         parts.append(f"{v['label'].removesuffix('  (finest)')}: {1e3 * v['cost_s_per_simulated_s']:.3g} ms/s, {how}, "
-                     f"faithful until {v['faithfulness']['faithful_until_s']:.2f} s")
+                     f"faithful until {until}")
     t = meta["timings_s"]
     return (f"{meta['preset']['name']}: {len(parts)} panels, {meta['frames']} frames {meta['width']}x{meta['height']}"
             f"@{meta['fps']} | " + " | ".join(parts) + f" | total {t['total']:.2f}s -> {out_dir}/")
