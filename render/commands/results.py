@@ -49,8 +49,7 @@ class RenderResult:
         """What `pendulum render` prints for this render: size, integrator, certificate, timings."""
         meta = self.metadata
         if "compare" in meta:  # a split screen: each variant's cost, divergence and certificate
-            from .comparison import summary
-            return summary(meta, self.dir)
+            return _compare_line(meta, self.dir)
         i, t = meta["integrator"], meta["timings_s"]
         drift = meta["energy"]["max_rel_drift"] if meta["energy"] else None
         drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
@@ -154,6 +153,22 @@ class Trajectory(Mapping):
                 ("energy drift", f"{self.energy_drift():.2g}" if "energy" in self.arrays else "?"),
                 ("file", str(self.path) if self.path else "not written (traj.save('x.npz') writes it)")]
         return _table(rows)
+
+
+def _compare_line(meta: dict, out_dir: Path) -> str:
+    """The comparison's line: each variant's cost, divergence and certificate, and where it went."""
+    parts = []
+    for i, v in enumerate(meta["compare"]["variants"]):
+        if i == meta["compare"]["finest"]:
+            how = "finest"
+        else:
+            how = "never parts" if v["divergence_s"] is None else f"parts at {v['divergence_s']:.2f} s"
+        until = faithful.until(v["faithfulness"]["faithful_until_s"], meta["duration"])
+        parts.append(f"{v['label'].removesuffix('  (finest)')}: {1e3 * v['cost_s_per_simulated_s']:.3g} ms/s, {how}, "
+                     f"faithful until {until}")
+    t = meta["timings_s"]
+    return (f"{meta['preset']['name']}: {len(parts)} panels, {meta['frames']} frames {meta['width']}x{meta['height']}"
+            f"@{meta['fps']} | " + " | ".join(parts) + f" | total {t['total']:.2f}s -> {out_dir}/")
 
 
 def _method(i: dict) -> str:
