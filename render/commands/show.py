@@ -259,7 +259,8 @@ class Window:
         import taichi as ti
 
         assert (ti.GUI.SPACE, ti.GUI.RIGHT, ti.GUI.ESCAPE, ti.GUI.EXIT) == (" ", "Right", "Escape", "WMClose")
-        self.press = ti.GUI.PRESS
+        self.press, self.release, self.motion, self.lmb = ti.GUI.PRESS, ti.GUI.RELEASE, ti.GUI.MOTION, ti.GUI.LMB
+        self.size = (width, height)
         try:
             with quiet_fds():
                 self.gui = ti.GUI(title, res=(width, height), fast_gui=True)
@@ -279,6 +280,22 @@ class Window:
 
     def keys(self):
         return [e.key for e in self.gui.get_events(self.press)]
+
+    def events(self):
+        """Keys pressed and the left button's moves since the last update: ("key", name, at), or ("press" |
+        "move" | "release", "LMB", at), at the frame pixel (x, y) under the cursor, row 0 at the top. Taichi
+        gives (x / w, (h − 1 − y) / h) in f32 (taichi 1.7.4, X11; tests/test_explore.py clicks known pixels)."""
+        w, h = self.size
+        out = []
+        for e in self.gui.get_events():
+            at = (min(max(round(e.pos[0] * w), 0), w - 1), min(max(h - 1 - round(e.pos[1] * h), 0), h - 1))
+            if e.key == self.lmb and e.type in (self.press, self.release):
+                out.append(("press" if e.type == self.press else "release", e.key, at))
+            elif e.type == self.motion:
+                out.append(("move", e.key, at))
+            elif e.type == self.press:
+                out.append(("key", e.key, at))
+        return out
 
     def blit(self, frame: np.ndarray):
         for c in range(3):
@@ -337,7 +354,12 @@ def add_parser(sub):
                "  r         restart from t = 0\n"
                "  s         save the frame on screen to OUT/NAME/NAME_frame_<index>.png\n"
                "  q, Esc    quit (so does closing the window)\n"
-               "At the end of the video the last frame stays up.")
+               "At the end of the video the last frame stays up.\n"
+               "A map (a preset with `fractal`) is explored with the mouse:\n"
+               "  hover     the title row shows the pixel's start and value\n"
+               "  click     an inset plays that pixel's pendulum\n"
+               "  drag      zoom into the box (the map is recomputed; in f64 where f32 cannot resolve it)\n"
+               "  b, BackSpace  close the inset, else back to the axes before the last zoom")
     s.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(s)
     s.add_argument("--out", type=Path, default=Path("out"), help="where s saves frames (default: out)")
@@ -361,6 +383,9 @@ def run(args) -> int:
     suggest = render_command(args)
     probe = check_display(suggest)  # before any compiling: a missing display fails at once
     try:
+        if scene.fractal:  # a map to explore: click, zoom, back (render/commands/explore.py)
+            from .explore import explore
+            return explore(scene, args.arch, args.threads, args.out, suggest, on_open=probe.close)
         source = pipeline.open_source(scene, arch=args.arch, threads=args.threads)  # a comparison: split screen
         return play(source, scene.video.fps, args.out, suggest, on_open=probe.close)
     finally:
