@@ -31,7 +31,8 @@ from ..maps import fractal
 from ..physics import grid
 from ..physics.stepper import Run
 from ..video import pipeline
-from .show import Player, Window, say
+from .show import Player, say
+from .window import Window
 
 BACK = ("b", "B", "BackSpace")
 DRAG_MIN = 4  # pixels: a press and release further apart than this is a box to zoom into, not a click
@@ -48,7 +49,6 @@ def pixel_scene(scene, start: dict, size: int):
         d.pop(key, None)
     d.update(name=f"{scene.name}_pixel", quality=None, effects=["rods", "bobs", "trails"])
     d["pendulums"].update(start, layout="fan", count=1, spread=0.0)
-    d["effects"] += ["damping"] if d["pendulums"]["damping"] > 0 else []
     d["video"].update(width=size, height=size, formats=["mp4"])
     return from_dict(d, f"{scene.source} (pixel)")
 
