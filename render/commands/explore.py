@@ -31,7 +31,7 @@ from ..maps import fractal
 from ..physics import grid
 from ..physics.stepper import Run
 from ..video import pipeline
-from .show import Player, say
+from .player import Player, say
 from .window import Window
 
 BACK = ("b", "B", "BackSpace")
