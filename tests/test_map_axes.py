@@ -3,7 +3,11 @@ frame shows, the energy barrier with rates on the axes, and a zoom too narrow fo
 agreeing with DOP853."""
 import json
 import math
+import re
+import shutil
+import subprocess
 
+import imageio.v3 as iio
 import numpy as np
 import pytest
 
@@ -25,6 +29,42 @@ ZOOM = SMALL + ["video.duration=2.5", "map.x_range=[-1.9005, -1.8995]", "map.y_r
 
 def number(label: str) -> float:
     return float(label.replace("−", "-"))
+
+
+def read_number(img: np.ndarray) -> float | None:
+    """A tick label read back by tesseract from a crop of the frame, as tests/test_gif.py reads its clock: the
+    bitmap font upscaled 4x, softened, dark on light, a few blurs tried in turn; None if none reads a number."""
+    from PIL import Image, ImageFilter
+
+    grey = Image.fromarray(255 - img.max(axis=2))
+    big = grey.resize((4 * grey.width, 4 * grey.height), Image.NEAREST)
+    for blur in (1.5, 1.7, 2.0, 1.2, 2.5):
+        soft = np.pad(np.asarray(big.filter(ImageFilter.GaussianBlur(blur))), 20, constant_values=255)
+        cmd = ["tesseract", "stdin", "stdout", "--psm", "7", "-c", "tessedit_char_whitelist=0123456789.-"]
+        out = subprocess.run(cmd, input=iio.imwrite("<bytes>", soft, extension=".png"), capture_output=True,
+                             check=True).stdout.decode()
+        found = re.fullmatch(r"\s*(-?\d+(\.\d+)?)\s*", out)
+        if found:
+            return float(found[1])
+    return None
+
+
+def labels_read_back(frame, lay, scene) -> list[tuple[float, float | None]]:
+    """(value, what tesseract reads) for every labelled tick of both axes, each label cropped from the frame
+    where decorate put it (x labels centred under their mark but clear of the legend, y labels right-aligned)."""
+    cw, ch = lay.cell()
+    out = []
+    (xq, *xr), (yq, *yr) = grid.axes_of(scene.map)
+    for t in axes.axis_ticks(xq, *xr, lay.w, lambda s: max(6, len(s) + 1) * cw):
+        if t.label:
+            half = len(t.label) * cw // 2
+            x, y = min(lay.x0 + t.at, lay.x0 + lay.w + 2 * lay.pad - half), lay.y0 + lay.h + 2 * lay.pad
+            out.append((t.value, read_number(frame[y - 2:y + ch + 1, x - half - 1:x + half + 1])))
+    for t in axes.axis_ticks(yq, *yr, lay.h, lambda s: 2 * ch):
+        if t.label:
+            x, y = lay.x0 - 2 * lay.pad, lay.y0 + lay.h - 1 - t.at
+            out.append((t.value, read_number(frame[y - ch // 2 - 2:y + ch // 2 + 2, x - len(t.label) * cw - 2:x + 1])))
+    return out
 
 
 def run_map(scene):
@@ -160,6 +200,10 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     # ticks: labels with the digits a 1e-3 window needs
     labels = [t.label for t in axes.axis_ticks("theta2", 2.2420, 2.2430, lay.h, lambda s: 26) if t.label]
     assert "2.2420" in labels and "2.2430" in labels
+    if shutil.which("tesseract"):  # and the frame's pixels say them: every label that reads, reads its value
+        read = labels_read_back(frames[-1], lay, scene)
+        assert all(got is None or abs(got - want) < 1e-9 for want, got in read), read
+        assert sum(got is not None for _, got in read) >= 0.75 * len(read) and len(read) >= 4, read
     # the map against DOP853 at 48 pixels, half of them flipped
     ev = mp.event.to_numpy().astype(np.float64)
     until = mp.until.to_numpy()

@@ -2,12 +2,12 @@
 
 The map plays as `render` draws it (show's Player: space, →, r, s, q/Esc), and the mouse asks it questions:
 
-- **hover**: the title row shows the cursor's (x, y), the start of the pixel under it, and that pixel's value
-  (its flip or divergence time so far, its FTLE);
+- **hover**: the title row shows the start (x, y) of the pixel under the cursor and that pixel's value (its
+  flip or divergence time so far, its FTLE);
 - **click** a pixel: an inset over the legend's corner plays that pixel's pendulum from its start, drawn by the
-  canvas `render` draws fans with (rods, bobs, trails), in the map's precision, looping; above it, its start
-  and its value. The inset's system is built for the one pendulum, so its start is read back from its state
-  and printed: "inset: theta1=... theta2=... pixel (c, r): flips at 1.61 s";
+  canvas `render` draws fans with (rods, bobs, trails), in the map's precision, looping; its start and value
+  in its top left. Its start is read back from the inset's own state and printed:
+  "inset: theta1=... theta2=... pixel (c, r): flips at 1.61 s";
 - **drag** a box over the plot: zoom. The map is recomputed from t = 0 for the box's ranges (the preset with
   map.x_range and map.y_range overridden, validated as a preset is: in f64 where f32 cannot resolve the pixel
   steps, render/physics/grid.py), and "axes: x theta1 [lo, hi], y theta2 [lo, hi], f64" is printed;
@@ -178,11 +178,14 @@ class Explorer:
         box = {"x_range": [xlo + c0 * dx, xlo + (c1 + 1) * dx], "y_range": [yhi - (r1 + 1) * dy, yhi - r0 * dy]}
         try:
             scene = self.stack[-1].replace(map=box)
-            self.log(f"zoom: computing the map for x {box['x_range']}, y {box['y_range']} ...")
+        except SceneError as e:  # e.g. narrower than f64 resolves: the map on show stays
+            return self.log(f"zoom: {e}")
+        self.log(f"zoom: computing the map for x {box['x_range']}, y {box['y_range']} ...")
+        try:
             self.open(scene)
-        except (SceneError, SimulationError) as e:
+        except (SceneError, SimulationError) as e:  # refused by its certificate or --quality
             self.log(f"zoom: {e}")
-            self.open(self.stack[-1])  # a refused run may have restarted Taichi: the map is recomputed
+            self.open(self.stack[-1])  # which may have restarted Taichi: the map before is recomputed
             return
         self.stack.append(scene)
 
