@@ -55,16 +55,25 @@ def labels_read_back(frame, lay, scene) -> list[tuple[float, float | None]]:
     cw, ch = lay.cell()
     out = []
     (xq, *xr), (yq, *yr) = grid.axes_of(scene.map)
-    for t in axes.axis_ticks(xq, *xr, lay.w, lambda s: max(6, len(s) + 1) * cw):
+    for t in axes.x_ticks(lay, xq, *xr):
         if t.label:
             half = len(t.label) * cw // 2
-            x, y = min(lay.x0 + t.at, lay.x0 + lay.w + 2 * lay.pad - half), lay.y0 + lay.h + 2 * lay.pad
+            x, y = axes.x_label_at(lay, t), lay.y0 + lay.h + 2 * lay.pad
             out.append((t.value, read_number(frame[y - 2:y + ch + 1, x - half - 1:x + half + 1])))
-    for t in axes.axis_ticks(yq, *yr, lay.h, lambda s: 2 * ch):
+    for t in axes.y_ticks(lay, yq, *yr):
         if t.label:
             x, y = lay.x0 - 2 * lay.pad, lay.y0 + lay.h - 1 - t.at
             out.append((t.value, read_number(frame[y - ch // 2 - 2:y + ch // 2 + 2, x - len(t.label) * cw - 2:x + 1])))
     return out
+
+
+def x_labels_apart(lay, scene):
+    """The x axis's labels neither touch each other (a character's gap at least) nor reach the legend."""
+    cw, _ = lay.cell()
+    boxes = [(axes.x_label_at(lay, t) - len(t.label) * cw / 2, axes.x_label_at(lay, t) + len(t.label) * cw / 2)
+             for t in axes.x_ticks(lay, *grid.axes_of(scene.map)[0]) if t.label]
+    assert all(b[0] - a[1] >= cw for a, b in zip(boxes, boxes[1:])), boxes
+    assert boxes[-1][1] <= lay.x0 + lay.w + 4 * lay.pad, boxes  # where the legend's column starts
 
 
 def run_map(scene):
@@ -159,8 +168,9 @@ def test_an_omega_map_starts_each_pixel_at_its_rates_and_draws_its_ticks():
     frame = frames[-1]
     d = src.canvas.decor
     label_at = {(x, y): s for s, x, y, _ in d.texts}
-    for (q, lo, hi), n, horizontal in zip(grid.axes_of(scene.map), (lay.w, lay.h), (True, False)):
-        ticks = axes.axis_ticks(q, lo, hi, n, (lambda s: max(6, len(s) + 1) * 6) if horizontal else (lambda s: 26))
+    for (q, lo, hi), horizontal in zip(grid.axes_of(scene.map), (True, False)):
+        ticks = (axes.x_ticks if horizontal else axes.y_ticks)(lay, q, lo, hi)
+        assert len([t for t in ticks if t.label]) >= 2
         assert [number(t.label) for t in ticks if t.label] == [t.value for t in ticks if t.label]
         for t in ticks:
             if horizontal:
@@ -168,12 +178,13 @@ def test_an_omega_map_starts_each_pixel_at_its_rates_and_draws_its_ticks():
                 assert (frame[lay.y0 + lay.h + 1:lay.y0 + lay.h + 1 + lay.pad, x] == axes.FRAME).all()
                 assert (frame[lay.y0 + lay.h + 2, x + 2] == axes.BACKGROUND).all()  # a mark, not a line
                 if t.label:
-                    assert label_at.get((x, lay.y0 + lay.h + 2 * lay.pad)) == t.label
+                    assert label_at.get((axes.x_label_at(lay, t), lay.y0 + lay.h + 2 * lay.pad)) == t.label
             else:
                 y = lay.y0 + lay.h - 1 - t.at
                 assert (frame[y, lay.x0 - 1 - lay.pad:lay.x0 - 1] == axes.FRAME).all()
                 if t.label:
                     assert label_at.get((lay.x0 - 2 * lay.pad, y)) == t.label
+    x_labels_apart(lay, scene)
     texts = [s for s, *_ in d.texts]
     assert "ω₁ [rad/s]" in texts and "ω₂" in texts and "rad/s" in texts
     assert "−5" in texts and "5" in texts
@@ -198,8 +209,9 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     assert np.allclose(np.diff(xs), step, rtol=1e-9, atol=0) and abs(xs[0] - (-1.9005 + step / 2)) < 1e-15
     assert src.sim.q.to_numpy().dtype == np.float64
     # ticks: labels with the digits a 1e-3 window needs
-    labels = [t.label for t in axes.axis_ticks("theta2", 2.2420, 2.2430, lay.h, lambda s: 26) if t.label]
+    labels = [t.label for t in axes.y_ticks(lay, "theta2", 2.2420, 2.2430) if t.label]
     assert "2.2420" in labels and "2.2430" in labels
+    x_labels_apart(lay, scene)
     if shutil.which("tesseract"):  # and the frame's pixels say them: every label that reads, reads its value
         read = labels_read_back(frames[-1], lay, scene)
         assert all(got is None or abs(got - want) < 1e-9 for want, got in read), read

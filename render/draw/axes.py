@@ -89,9 +89,37 @@ def axis_ticks(quantity: str, lo: float, hi: float, n: int, spacing) -> list[Tic
             return [Tick(v, at(v), label) for v, label in ticks]
         single = single or [Tick(v, at(v), label) for v, label in ticks]
         if len(ticks) >= 2:  # if none fits: the coarsest with two ticks or more, every k-th labelled
-            every = math.ceil(need / gap)
+            every = math.ceil(need / gap - 1e-9)
             fallback = [Tick(v, at(v), label if i % every == 0 else None) for i, (v, label) in enumerate(ticks)]
     return fallback or single
+
+
+def x_ticks(lay: grid.Layout, quantity: str, lo: float, hi: float) -> list[Tick]:
+    """The x axis's ticks: labels side by side need 6 characters (π units: "−π/2" and a space) or their length
+    and two."""
+    cw, _ = lay.cell()
+    ticks, end = axis_ticks(quantity, lo, hi, lay.w, lambda s: max(6, len(s) + 2) * cw), -math.inf
+    for i, t in enumerate(ticks):  # a label shifted clear of the legend may meet the one before: it goes
+        if t.label:
+            x = x_label_at(lay, t)
+            if x - len(t.label) * cw / 2 < end + cw:
+                ticks[i] = dataclasses.replace(t, label=None)
+            else:
+                end = x + len(t.label) * cw / 2
+    return ticks
+
+
+def y_ticks(lay: grid.Layout, quantity: str, lo: float, hi: float) -> list[Tick]:
+    """The y axis's ticks: labels one above the other need two rows."""
+    _, ch = lay.cell()
+    return axis_ticks(quantity, lo, hi, lay.h, lambda s: 2 * ch)
+
+
+def x_label_at(lay: grid.Layout, t: Tick) -> int:
+    """Where an x tick's label is centred: on its mark, but clear of the legend's column (long decimals at the
+    right end shift left)."""
+    cw, _ = lay.cell()
+    return min(lay.x0 + t.at, lay.x0 + lay.w + 3 * lay.pad - len(t.label) * cw // 2)
 
 
 def decimal(v: float, decimals: int) -> str:
@@ -154,13 +182,11 @@ def decorate(scene, lay: grid.Layout, times: tuple[float, float], run: str) -> D
                 (x0 - 1, y0 - 1, 1, h + 2, FRAME), (x0 + w, y0 - 1, 1, h + 2, FRAME)]
     tick = max(1, lay.height // 360)
     (xq, *xr), (yq, *yr) = grid.axes_of(scene.map)
-    # labels side by side need a gap of 6 characters (π units: "−π/2" and a space) or their length and one
-    for t in axis_ticks(xq, *xr, w, lambda s: max(6, len(s) + 1) * cw):
+    for t in x_ticks(lay, xq, *xr):
         d.rects.append((x0 + t.at, y0 + h + 1, tick, pad, FRAME))
-        if t.label:  # centred on its tick, but clear of the legend's column (long decimals at the right end)
-            x = min(x0 + t.at, x0 + w + 2 * pad - len(t.label) * cw // 2)
-            d.texts.append((t.label, x, y0 + h + 2 * pad, {**small, "ha": "center"}))
-    for t in axis_ticks(yq, *yr, h, lambda s: 2 * ch):
+        if t.label:
+            d.texts.append((t.label, x_label_at(lay, t), y0 + h + 2 * pad, {**small, "ha": "center"}))
+    for t in y_ticks(lay, yq, *yr):
         y = y0 + h - 1 - t.at
         d.rects.append((x0 - 1 - pad, y, pad, tick, FRAME))
         if t.label:
