@@ -1,5 +1,6 @@
-"""`pendulum show MAP_PRESET` under Xvfb, driven by xdotool: a click opens an inset whose pendulum starts at the
-clicked pixel's (θ1, θ2), a dragged box zooms to exactly the box's pixels, and b goes back.
+"""`pendulum show MAP_PRESET`: the Explorer without a window (a click's inset, a box's zoom, back), and the real
+window under Xvfb, driven by xdotool: a click opens an inset whose pendulum starts at the clicked pixel's
+(θ1, θ2), a dragged box zooms to exactly the box's pixels, and b goes back.
 
 Needs (Debian): apt-get install -y xvfb xdotool; skipped cleanly without them (the xvfb fixture of test_show).
 Without a display at all, show of a map fails as show of any preset does: tests/test_show.py.
@@ -16,6 +17,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
+from render.commands.explore import Explorer
+from render.config.scene import load
 from render.draw import axes
 from render.physics import grid
 from test_show import env_without_display, grab_window, xdotool, xvfb  # noqa: F401 - xvfb is a fixture
@@ -46,6 +49,41 @@ class Lines:
             if m:
                 return m
         pytest.fail(f"timed out waiting for {pattern!r}; saw {self.seen}")
+
+
+def test_the_explorer_without_a_window(tmp_path):
+    """On a 64x64 map (all plot, no decorations): hover, click, drag and b, as the window would pass them."""
+    said = []
+    scene = load("fractal_flip", ["video.width=64", "video.height=64", "video.fps=10", "video.duration=1"])
+    ex = Explorer(scene, "cpu", None, tmp_path, log=said.append)
+    assert (ex.lay.x0, ex.lay.y0, ex.lay.w, ex.lay.h) == (0, 0, 64, 64)
+    ex.mouse("move", (10, 50))
+    frame = ex.compose()
+    assert frame.shape == (64, 64, 3) and (frame[:14].max(-1) > 150).any()  # the hover caption
+    ex.mouse("press", (40, 8))
+    ex.mouse("release", (41, 9))  # a click: under DRAG_MIN apart
+    q, v = ex.inset.run.sim.q.to_numpy()[0], ex.inset.run.sim.v.to_numpy()[0]
+    step = 2 * np.pi / 64
+    assert np.allclose(q, [-np.pi + 41.5 * step, np.pi - 9.5 * step], rtol=2e-7) and not v.any()  # f32
+    assert said[-1].startswith("inset: theta1=") and "pixel (41, 9)" in said[-1]
+    size, at = ex.inset.frame.shape[0], 64 - 3 - ex.inset.frame.shape[0]  # bottom right, 3 px in
+    out = ex.compose()
+    assert (out[at - 1, at:at + size] == axes.FRAME).all() and (out[at:at + size, at - 1] == axes.FRAME).all()
+    assert (out[at:at + size, at:at + size] != ex.player.frame[at:at + size, at:at + size]).any()
+    ex.key("b")
+    assert ex.inset is None and said[-1] == "inset closed"
+    ex.mouse("press", (8, 40))
+    ex.mouse("move", (23, 55))
+    assert (ex.compose()[40, 8:24] == 255).all()  # the box being dragged
+    ex.mouse("release", (23, 55))
+    (xq, xlo, xhi), (yq, ylo, yhi) = grid.axes_of(ex.scene.map)
+    assert np.allclose([xlo, xhi, ylo, yhi], [-np.pi + 8 * step, -np.pi + 24 * step, np.pi - 56 * step,
+                                              np.pi - 40 * step], rtol=0, atol=1e-12)
+    assert len(ex.stack) == 2 and ex.scene.integrator.precision == "f32"
+    ex.key("b")
+    assert len(ex.stack) == 1 and grid.axes_of(ex.scene.map) == grid.axes_of(scene.map)
+    ex.key("b")
+    assert said[-1] == "at the preset's own axes"
 
 
 def test_click_opens_the_pixels_pendulum_and_a_box_zooms(xvfb, tmp_path):  # noqa: F811 - the fixture

@@ -122,7 +122,7 @@ class Explorer:
         self.player = Player(self.source, scene.video.fps, self.save_dir)
         self.size = self.lay.font or "6x13"  # the decorations' font; a map too small for them: the smaller one
         self.font = self.source.canvas.font or Font(self.size)
-        self.axes = grid.axes_of(self.scene.map)
+        self.axes, self.starts = grid.axes_of(self.scene.map), grid.starts(self.scene)
         (xq, xlo, xhi), (yq, ylo, yhi) = self.axes
         self.log(f"axes: x {xq} [{xlo!r}, {xhi!r}], y {yq} [{ylo!r}, {yhi!r}], {self.scene.integrator.precision}")
         self.changed = True
@@ -136,9 +136,9 @@ class Explorer:
         return (c, r) if 0 <= c < self.lay.w and 0 <= r < self.lay.h else None
 
     def start_of(self, c: int, r: int) -> dict:
-        """The (x, y) start of plot pixel (c, r): its centre's values, row 0 at the top (grid.starts)."""
-        (xq, xlo, xhi), (yq, ylo, yhi) = self.axes
-        return {xq: grid.pixel_value(self.lay.w, xlo, xhi, c), yq: grid.pixel_value(self.lay.h, yhi, ylo, r)}
+        """The (x, y) start of plot pixel (c, r), to the bit as the map's (grid.starts: row 0 at the top)."""
+        x, y = self.starts[r * self.lay.w + c]
+        return {self.axes[0][0]: float(x), self.axes[1][0]: float(y)}
 
     # ------------------------------------------------------------ what the mouse and keys do
     def key(self, key: str):
@@ -228,7 +228,7 @@ class Explorer:
             c, r = cell
             start = "  ".join(f"{axes.symbol(k)} {v:.6g}" for k, v in self.start_of(c, r).items())
             value = value_text(self.source.canvas, self.scene.fractal, r * lay.w + c, self.source.sim.t)
-            out[:max(lay.y0 - 1, ch + 2), :lay.width - 13 * cw] = axes.BACKGROUND
+            out[:max(lay.y0 - 1, ch + 2), :lay.width - 13 * cw if lay.font else lay.width] = axes.BACKGROUND
             texts.append((f"{start}  {value}", pad, pad if lay.y0 else 1, {}))
         if self.press is not None and self.cursor is not None:
             (xa, ya), (xb, yb) = self.press, self.cursor

@@ -161,11 +161,6 @@ def axes_summary(scene) -> dict:
     return out
 
 
-def pixel_value(n: int, lo: float, hi: float, at: float) -> float:
-    """The value at the centre of pixel `at` (0 .. n − 1) of an axis of n pixels over [lo, hi]."""
-    return float(lo + (at + 0.5) * ((hi - lo) / n))
-
-
 def starts(scene) -> np.ndarray:
     """Per pixel of the plot, row-major from the top left, the (x, y) values it starts at: (pixels, 2)."""
     lay = plot(scene)
