@@ -236,6 +236,7 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     r = run_cli("render", "fractal_flip", "--out", tmp_path, "--name", "zoom", "--no-progress",
                 *[a for s in ZOOM + ['video.formats=["png"]', "video.duration=0.2"] for a in ("--set", s)])
     assert r.returncode == 0, r.stderr
+    assert "f64 (f64: the zoom is finer than f32 resolves)" in r.stdout, r.stdout
     meta = json.loads((tmp_path / "zoom" / "metadata.json").read_text())
     assert meta["integrator"]["precision"] == "f64" and "f64" in meta["map"]["axes"]
     assert meta["map"]["axes"]["y"] == {"quantity": "theta2", "unit": "rad", "range": [2.242, 2.243]}
