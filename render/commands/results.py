@@ -55,6 +55,8 @@ class RenderResult:
         drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
         q = meta["quality"]
         level = f" ({q['level']}: {'met' if q.get('met') else 'NOT met'})" if q["level"] else " (as the preset states)"
+        if "f64" in meta.get("map", {}).get("axes", {}):  # promoted: a zoom finer than f32 resolves (physics/grid.py)
+            level = (level if q["level"] else "") + " (f64: the zoom is finer than f32 resolves)"
         return (f"{meta['preset']['name']}: {meta['frames']} frames {meta['width']}x{meta['height']}@{meta['fps']} | "
                 f"{_method(i)}{level}{drift_s} | {faithful.sentence(self.certificate, meta['duration'])} | "
                 f"simulate {t['simulate']:.2f}s draw {t['draw']:.2f}s encode {t['encode']:.2f}s "
