@@ -88,8 +88,7 @@ _built: list = []  # (generation, constants, system, bytes of its fields by name
 def build(scene, subset=None, precision: str | None = None):
     """The scene's system in the current runtime: a free one built earlier with the same constants, loaded
     with this scene's start, or a new one."""
-    cls = registry.get(scene.system)
-    plan = cls(scene, subset, allocate=False)  # the step and the constants, no field
+    plan = registry.get(scene.system)(scene, subset, allocate=False)  # the step and the constants, no field
     key = constants(plan, precision or scene.integrator.precision)
     _built[:] = [b for b in _built if b[0] == runtime.generation()]  # a restart freed the others' fields
     for entry in _built:
@@ -101,7 +100,7 @@ def build(scene, subset=None, precision: str | None = None):
                 runtime.allocated[name] = runtime.allocated.get(name, 0) + size
             return sim
     before = dict(runtime.allocated)
-    sim = cls(scene, subset)
+    sim = registry.get(scene.system)(scene, subset)
     if key is not None:
         _built.append((runtime.generation(), key, sim,
                        {k: v - before.get(k, 0) for k, v in runtime.allocated.items() if v != before.get(k, 0)}))
