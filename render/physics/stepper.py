@@ -20,6 +20,7 @@ twice compiles once.
 """
 from __future__ import annotations
 
+import gc
 import sys
 import time
 
@@ -91,8 +92,11 @@ def build(scene, subset=None, precision: str | None = None):
     plan = registry.get(scene.system)(scene, subset, allocate=False)  # the step and the constants, no field
     key = constants(plan, precision or scene.integrator.precision)
     _built[:] = [b for b in _built if b[0] == runtime.generation()]  # a restart freed the others' fields
-    for entry in _built:
-        if key is not None and entry[1] == key and sys.getrefcount(entry[2]) <= FREE:
+    same = [entry for entry in _built if key is not None and entry[1] == key]
+    if same and all(sys.getrefcount(entry[2]) > FREE for entry in same):
+        gc.collect()  # a finished run's generator and closures may hold its system in a cycle until then
+    for entry in same:
+        if sys.getrefcount(entry[2]) <= FREE:
             sim = entry[2]
             vars(sim).update(vars(plan))
             sim.restart()
