@@ -110,6 +110,7 @@ class MapSpec:
     epsilon: float
     threshold: float
     trust_stride: int
+    samples: int = 1  # sub-pixel starts per pixel
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,6 +165,8 @@ class Scene:
         d.pop("budget", None)  # the same frames under any budget: the same folder, up to date in `batch`
         if d["integrator"]["trig"] == "inline":  # the default of a key added later: scenes keep their hash
             del d["integrator"]["trig"]
+        if d.get("map", {}).get("samples") == 1:
+            del d["map"]["samples"]
         blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 

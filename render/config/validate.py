@@ -30,7 +30,9 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
     "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
     "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
     "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
+    "samples": 1,  # sub-pixel starts per pixel (render/physics/grid.py's sample_starts)
 }
+SAMPLES = (1, 4, 9)  # map.samples: a pixel's centre, or a regular 2 x 2 or 3 x 3 split of it
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 # New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
 EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov",
@@ -217,7 +219,16 @@ class Validator:
         thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
         if fractal == "divergence" and thr <= eps:
             self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
-        return {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096)}
+        return {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096),
+                "samples": self.samples(d)}
+
+    def samples(self, d) -> int:
+        """map.samples, which the grid's pendulum count needs before [map] is read."""
+        val = d["map"]["samples"]
+        if isinstance(val, bool) or not isinstance(val, int) or val not in SAMPLES:
+            self.fail("map.samples", f"must be 1, 4 or 9 (a pixel's centre, or a 2 x 2 or 3 x 3 split of it), "
+                      f"got {clip(repr(val))}")
+        return val
 
     def video(self, d) -> dict:
         w = self.integer(d, "video", "width", 16, 7680)
@@ -244,14 +255,19 @@ class Validator:
     def pendulums(self, d, system, video, fractal) -> dict:
         layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
         if layout == "grid":
-            want = grid.pendulums(video["width"], video["height"], fractal)
+            samples = self.samples(d)
+            want = grid.pendulums(video["width"], video["height"], fractal, samples)
             if d["pendulums"]["count"] is None:
                 d["pendulums"]["count"] = want
             lay = grid.layout(video["width"], video["height"])
+            each = f"{samples} sub-pixel starts" if samples > 1 else "one pendulum"
             if d["pendulums"]["count"] != want:
-                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
-                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video['width']}x"
+                self.fail("pendulums.count", f"a grid has {each} per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if fractal == 'divergence' else ''} in a {video['width']}x"
                           f"{video['height']} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+            if samples > 1 and want > MAX_PENDULUMS:
+                self.fail("map.samples", f"{each} per pixel of a {lay.w}x{lay.h} plot make {want} pendulums, more "
+                          f"than {MAX_PENDULUMS}; use fewer samples or a smaller video")
         elif d["pendulums"]["count"] is None:
             self.fail("pendulums.count", "missing (this key is required)")
         count = self.integer(d, "pendulums", "count", 1, MAX_PENDULUMS)
