@@ -12,7 +12,7 @@ from conftest import run_cli
 from render.config import budget, estimate
 from render.config.scene import load
 from render.errors import SceneError
-from render.maps import fractal, supersample
+from render.maps import data, fractal, supersample
 from render.physics import grid, reference, registry
 from render.video import pipeline
 
@@ -163,6 +163,26 @@ def test_a_2x2_supersampled_map_integrates_the_samples_a_map_twice_as_fine_has_a
     assert (ev >= 0).sum() > 100 and (ev == fractal.NEVER).sum() > 100
     assert np.array_equal(mine == fractal.NEVER, ev == fractal.NEVER)
     assert (mine == ev).mean() > 0.999  # the same f32 starts and arithmetic: the same times, to the bit (here all)
+
+
+@pytest.mark.slow
+def test_an_ftle_map_of_4_samples_holds_each_samples_sigma_and_draws_the_barrier_on_their_grid():
+    """As for the flip map: a 16×16 FTLE map of 4 samples is, sample for sample, the 32×32 map (σ_t, the
+    barrier's curve, the cannot-flip mask), and its data hold σ_t per sample in 1/s."""
+    got = []
+    for scene in (small("fractal_lyapunov", 32, 0.3), small("fractal_lyapunov", 16, 0.3, "map.samples=4")):
+        src = pipeline.Source(scene)
+        for _ in range(src.frames):
+            src.next_frame()
+        got.append((data.arrays(scene, src.canvas), src.canvas.edge.to_numpy()))
+    (fine, fine_edge), (four, edge) = got
+    assert (str(four["colouring"]), str(four["unit"]), four["value"].shape) == ("lyapunov", "1/s", (16, 16, 4))
+    sigma = fine["value"].reshape(32, 32)
+    assert np.abs(supersample.fine_grid(four["value"].ravel(), 16, 16, 4) - sigma).max() < 1e-9 and sigma.max() > 0.5
+    inside = fine["cannot_flip"].reshape(32, 32)
+    assert np.array_equal(supersample.fine_grid(four["cannot_flip"].ravel(), 16, 16, 4), inside) and inside.any()
+    assert np.array_equal(supersample.fine_grid(edge, 16, 16, 4), fine_edge.reshape(32, 32)) and edge.sum() > 20
+    assert np.array_equal(four["trusted"], np.repeat((four["trusted_until"] >= np.float32(four["t"]))[..., None], 4, -1))
 
 
 def test_a_supersampled_pixel_is_its_samples_colours_averaged_in_linear_light(tmp_path):
