@@ -30,6 +30,12 @@ certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_in
 pendulums, and each pixel's faithful time is the least of its lattice neighbours' (grid.faithful_map). A
 pixel whose claim reaches past that time is drawn desaturated and hatched. Pixels that cannot flip are
 trusted: energy, not the integration, settles them.
+
+**Samples and data.** With map.samples = 4 or 9 a pixel is 4 or 9 sub-pixel starts (grid.sample_starts), the
+map's *points*: each is its own pendulum (with its own twin), with its own event and its own claim against
+the pixel's faithful time, and the pixel shows their colours' mean in linear light (render/maps/supersample.py).
+With one sample, a point is its pixel. result() hands each point's value, claim and cannot-flip mask to the
+map's NAME.npz (render/maps/data.py).
 """
 
 import math
