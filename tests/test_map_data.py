@@ -11,7 +11,7 @@ import render
 from conftest import run_cli
 from render.config import budget, estimate
 from render.config.scene import load
-from render.errors import SceneError
+from render.errors import EncodeError, SceneError
 from render.maps import data, fractal, supersample
 from render.physics import grid, reference, registry
 from render.video import pipeline
@@ -127,6 +127,19 @@ def test_load_map_refuses_what_is_not_a_map(tmp_path):
     (tmp_path / "y.npz").write_text("hello")
     with pytest.raises(ValueError, match="y.npz: not a map's data"):
         render.load_map(tmp_path / "y.npz")
+
+
+def test_a_render_that_fails_as_it_finishes_leaves_no_npz(tmp_path, monkeypatch):
+    from render.video import encode
+
+    def failing(self, audio=None):
+        self.abort()
+        raise EncodeError("ffmpeg failed (a test)")
+
+    monkeypatch.setattr(encode.Encoder, "close", failing)
+    with pytest.raises(EncodeError):
+        pipeline.render(small("fractal_flip", 32, 0.2), tmp_path)
+    assert not list(tmp_path.rglob("*"))  # no NAME.npz, no temporary, and the folder made for them is gone
 
 
 # ---------------------------------------------------------------- supersampling
