@@ -10,7 +10,7 @@ from conftest import run_cli
 from render.config import budget, estimate
 from render.config.scene import load
 from render.errors import EncodeError, SceneError
-from render.maps import data, fractal, supersample
+from render.maps import colours, data, fractal, supersample
 from render.physics import grid, reference, registry
 from render.video import pipeline
 
@@ -31,8 +31,8 @@ def rendered(scene, out):
 # ---------------------------------------------------------------- the colours an npz's values call for
 
 def palette(u):
-    """fractal.PALETTE at u in [0, 1], piecewise linear, as numpy: (..., 3)."""
-    stops = np.asarray(fractal.PALETTE)
+    """colours.PALETTE at u in [0, 1], piecewise linear, as numpy: (..., 3)."""
+    stops = np.asarray(colours.PALETTE)
     x = np.clip(u, 0.0, 1.0) * (len(stops) - 1)
     k = np.minimum(np.floor(x).astype(int), len(stops) - 2)
     f = (x - k)[..., None]
@@ -42,17 +42,17 @@ def palette(u):
 def sample_colours(d, time_scale):
     """Each sample's colour (H, W, S, 3) from the npz alone: its flip time on the log scale (early bright),
     black where it cannot flip, grey while pending; where it is not trusted, most of the colour drained and a
-    diagonal hatch every fractal.HATCH pixels."""
+    diagonal hatch every colours.HATCH pixels."""
     lo, hi = time_scale
     v = d.value.astype(np.float64)
     u = (np.log(np.maximum(v, lo)) - np.log(lo)) / np.log(hi / lo)
     col = np.where((v >= 0)[..., None], palette(1 - u), 0.0)
-    col[v == d.pending] = fractal.PENDING_GREY
+    col[v == d.pending] = colours.PENDING_GREY
     col[v == d.never] = 0.0
     lum = (col * [0.3, 0.59, 0.11]).sum(-1, keepdims=True)
     drained = 0.75 * (lum + 0.3 * (col - lum))
     r, c = np.indices(v.shape[:2])
-    hatch = ((r + c) % fractal.HATCH == 0)[..., None, None]
+    hatch = ((r + c) % colours.HATCH == 0)[..., None, None]
     drained = np.where(hatch, np.where(lum > 0.45, 0.1, 0.5), drained)
     return np.where(d.trusted[..., None], col, drained)
 

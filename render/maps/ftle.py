@@ -45,7 +45,7 @@ in the vectorised loop is the way to close that gap.
 import numpy as np
 import taichi as ti
 
-from . import fractal, supersample
+from . import colours, fractal, supersample
 from ..physics import grid, integrators, runtime
 from ..draw.font import Font
 from ..physics.tangent import check_method, libm_twin, scalarized
@@ -206,17 +206,17 @@ class FtleMap(fractal.Map):
         if t > 0.0:
             s = (self.log_scale[j] + self.log_smax(j)) / t
         self.sigma[j] = s
-        col = fractal.palette(s / SIGMA_MAX)
+        col = colours.palette(s / SIGMA_MAX)
         if self.edge[j]:
             col = ti.Vector([0.0, 0.0, 0.0])
         if t > self.until[p]:
-            col = fractal.untrusted(col, c, r)
+            col = colours.untrusted(col, c, r)
         return col
 
     @ti.func
     def bar_colour(self, u):
         """The colour bar's colour at u in [0, 1] (bottom to top): σ = u·SIGMA_MAX."""
-        return fractal.palette(u)
+        return colours.palette(u)
 
     @ti.kernel
     def ftle_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
