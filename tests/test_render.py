@@ -77,7 +77,7 @@ def test_metadata_has_the_contract_fields(rendered, name):
         # a comparison's drift is its worst variant's, a coarse method shown on purpose: the watchdog's bound
         floor = DEFAULT_MAX_DRIFT if "compare" in meta else 1e-3
         assert 0 <= meta["energy"]["max_rel_drift"] < max(floor, meta["preset"]["integrator"]["max_drift"] or 0)
-    for key in ("faithfulness", "quality"):  # certified renders (DESIGN.md, round 2)
+    for key in ("faithfulness", "quality"):  # certified renders (docs/certified-renders.md)
         assert key in meta, key
     assert not list(d.glob(".*")), "temporary files left behind"
 

@@ -3,8 +3,9 @@
 Every phase runs in its own subprocess (a fresh Taichi runtime) while this process samples the resident memory
 of that process tree (ffmpeg included), so all figures of one report come from one run. Precision is fixed
 per Taichi init, so the simulation phase runs f32, then f64. Every ratio against a peer (numpy, numba,
-matplotlib, the peak rate of render/peak.py) comes from --repeat interleaved rounds (render/peers.py) and
-is reported with its spread over them. Method and findings: benchmarks/README.md.
+matplotlib, the peak rate of render/commands/peak.py) comes from --repeat interleaved rounds
+(render/commands/peers.py) and is reported with its spread over them. Method and findings:
+benchmarks/README.md.
 """
 from __future__ import annotations
 
@@ -173,8 +174,8 @@ def maxrss_mb() -> float:  # the largest single process: this phase, or one of i
 
 def phase_sim(cfg, arch, tmp) -> dict:
     """Pendulum-substeps per second of the Taichi kernel and of the numpy baseline, same RK4, same state, in
-    interleaved rounds; at N = 1e5 the numba peer too, and for the rigid kernel render/peak.py's peak rate,
-    whose ratio to the kernel's flop rate is rigid_rk4_peak_fraction."""
+    interleaved rounds; at N = 1e5 the numba peer too, and for the rigid kernel the peak rate of
+    render/commands/peak.py, whose ratio to the kernel's flop rate is rigid_rk4_peak_fraction."""
     import taichi as ti
     from ..physics.stepper import Run
     from ..config.scene import load
@@ -324,9 +325,9 @@ def canvas_frame(scene) -> np.ndarray:
 
 
 def phase_hud(cfg, arch, tmp) -> dict:
-    """ms per frame of rigid_chaos's HUD alone at 1280x720 (render/hud.py's Hud, as the canvas calls it, without a
-    certificate as in benchmarks/effects.py): drawn onto a blank frame at every frame of the simulation, so its
-    spread is the live one; the median over the frames after the first two (which compile)."""
+    """ms per frame of rigid_chaos's HUD alone at 1280x720 (the Hud of render/draw/hud.py, as the canvas calls
+    it, without a certificate as in benchmarks/effects.py): drawn onto a blank frame at every frame of the
+    simulation, so its spread is the live one; the median over the frames after the first two (which compile)."""
     import taichi as ti
     from ..physics.stepper import Run
     from ..draw.hud import Hud, Info
@@ -410,7 +411,7 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
                        "load_avg": LOAD_AT_START, "load_avg_end": list(os.getloadavg())},
            "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
            "sim_speedup_vs_numpy_1e5": at[headline], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
-           "fractal_fps": {c: r["fps"] for c, r in fr.items()},  # DESIGN.md: per colouring
+           "fractal_fps": {c: r["fps"] for c, r in fr.items()},  # docs/performance.md: one per colouring
            "fractal_peak_mem_mb": max(r["peak_mem_mb"] for r in fr.values()),
            "rainbow_1000_draw_fps": rb["draw_fps"], "rainbow_1000": rb,
            "draw_fps": enc["draw_fps"], "sim_draw_fps": enc["sim_draw_fps"], "encode_fps": enc["encode_fps"],
@@ -425,7 +426,7 @@ def summarise(res: dict, quick: bool, wall: float) -> dict:
            "spread": {**peers.spreads(rows, mpl), **{f"rigid_rk4_peak_fraction.{p}": v["fraction"]
                                                      for p, v in pk.items()}},
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING}}
-    rep.update({"hud_ms_per_frame": rep["hud_ms_720p"],  # DESIGN.md's names for the same figures
+    rep.update({"hud_ms_per_frame": rep["hud_ms_720p"],  # the same figures, named as the first targets were
                 **{f"peak_flops_{p}": v["peak_gflops"] * 1e9 for p, v in pk.items()},
                 **{f"rigid_rk4_fraction_of_peak_{p}": v["fraction"]["value"] for p, v in pk.items()}})
     for key, op, goal in TARGETS:
@@ -540,7 +541,8 @@ def markdown(r: dict) -> str:
                    "" if s["n"] != 10**5 else fmt(s["numba"] and s["numba"] / 1e6, ".2f"),
                    "" if s["n"] != 10**5 else with_spread(s["vs"]["numba"]), f"{s['agree']:.1e}"]
                   for s in r["sim"]])
-    out += ["", "## Peak floating-point rate (render/peak.py) and the rigid RK4 kernel's share of it (N=1e5)", ""]
+    out += ["", "## Peak floating-point rate (render/commands/peak.py) and the rigid RK4 kernel's share of it "
+            "(N=1e5)", ""]
     out += table(["precision", "peak GFLOP/s", "flops per RK4 step", "rigid RK4 GFLOP/s", "fraction of peak (range)"],
                  [[p, f"{v['peak_gflops']:.1f}", v["flops_per_step"], f"{v['rigid_rk4_gflops']:.1f}",
                    with_spread(v["fraction"], ".3f")] for p, v in r["peak"].items()])

@@ -5,7 +5,7 @@ The plot is H rows × W columns, row 0 at the top as drawn; S = map.samples (1, 
 per pixel, row by row from the pixel's top left (render/physics/grid.py's sample_starts). Fields:
 
 - `x` (W,), `y` (H,) float64: the axes' values at the pixels' centres; `x_quantity`, `y_quantity`: what
-  they are ("theta1", "theta2"; rad);
+  they are ([map] x and y: "theta1", "omega2", ...), `x_unit`, `y_unit` theirs ("rad", "rad/s");
 - `starts` (H, W, S, 2) float64: each sample's (x, y) start;
 - `colouring`: the preset's `fractal`; `value`: what it measures, per sample, at the last frame: flip_time
   and divergence, the event's time in s (float32; `pending` -1: not happened by then, `never` -2: cannot
@@ -44,6 +44,8 @@ class MapData:
     unit: str
     x_quantity: str
     y_quantity: str
+    x_unit: str
+    y_unit: str
     x: np.ndarray
     y: np.ndarray
     starts: np.ndarray
@@ -67,9 +69,10 @@ def arrays(scene, mp) -> dict[str, np.ndarray]:
     shape = (lay.h, lay.w, n)
     centres = grid.starts(scene).reshape(lay.h, lay.w, 2)
     until = mp.until.to_numpy().reshape(lay.h, lay.w)
-    xq, yq = grid.quantities(scene)
+    (xq, *_), (yq, *_) = grid.axes_of(scene.map)
     return {"colouring": np.str_(scene.fractal), "unit": np.str_(UNITS[scene.fractal]),
             "x_quantity": np.str_(xq), "y_quantity": np.str_(yq),
+            "x_unit": np.str_(grid.unit(xq)), "y_unit": np.str_(grid.unit(yq)),
             "x": centres[0, :, 0].copy(), "y": centres[:, 0, 1].copy(),
             "starts": grid.sample_starts(scene).reshape(*shape, 2),
             "value": res["value"].reshape(*shape, *res["value"].shape[1:]), "t": np.float64(mp.sim.t),
@@ -98,7 +101,7 @@ def load(path) -> MapData:
         if missing:
             raise ValueError(f"{path}: not a map's data (no {', '.join(missing)})")
         got = {k: z[k] for k in fields}
-    for k in ("colouring", "unit", "x_quantity", "y_quantity"):
+    for k in ("colouring", "unit", "x_quantity", "y_quantity", "x_unit", "y_unit"):
         got[k] = str(got[k])
     for k in ("t", "pending", "never"):
         got[k] = float(got[k])

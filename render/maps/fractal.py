@@ -1,4 +1,5 @@
-"""Fractal maps: one pendulum per pixel of a θ1 × θ2 plot (render/physics/grid.py), coloured by what it does.
+"""Fractal maps: one pendulum per pixel of a plot of two start quantities (θ1 × θ2 unless [map] x and y say
+otherwise: render/physics/grid.py), coloured by what it does.
 
 The preset key `fractal` picks the colouring:
 - **angles**: the pixel's current angles as a colour (R sin θ1, G sin θ2, B cos(θ1 + θ2));
@@ -19,7 +20,8 @@ integrator (integrators.step on the system's force, lane matrices as in System.a
 a sum of one term per link. On the set where link k points straight up (θ_k = ±π) it is least with every
 other link hanging, where it is B_k = 2 g μ_k l_k. Energy never grows (damping only removes it) and kinetic
 energy is not negative, so a pendulum with E < B_k can never bring link k over the top, and one with
-E < B = min_k B_k flips no link at all: it is black from the first frame and never integrated. From rest,
+E < B = min_k B_k flips no link at all: it is black from the first frame and never integrated. E is each
+start's full energy (fractal_setup: kinetic too, so the claim holds with rates on the axes); from rest,
 E = V(θ(0)); for two links of equal unit masses and lengths, B = 2g and the condition is 2 cos θ1 + cos θ2
 > 1. The bound is tight: the state with link k up and the others hanging, at rest, has E = B_k exactly, so
 no smaller barrier holds (tests/test_fractal.py: a DOP853 run flips no pixel inside it, and starts just
@@ -68,7 +70,7 @@ class Map(runtime.Launcher):
 
     def __init__(self, scene, sim, cert):
         v, self.scene, self.sim, self.kind = scene.video, scene, sim, scene.fractal
-        self.lay = grid.layout(v.width, v.height)
+        self.lay = grid.plot(scene)
         self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
         self.samples = scene.map.samples  # sub-pixel starts per pixel (render/maps/supersample.py)
         self.points = self.pixels * self.samples  # the starts: pixel p's samples are points p·samples + s
@@ -137,6 +139,7 @@ class Map(runtime.Launcher):
         claim = np.where(done, ev, t)
         lay, stride = self.lay, self.scene.map.trust_stride
         return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "axes": grid.axes_summary(self.scene),
                 "pixels": self.pixels, "samples": self.samples, "time_scale_s": [self.lo, self.hi],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},

@@ -63,7 +63,7 @@ class FtleMap(fractal.Map):
     def __init__(self, scene, sim, cert):
         check_method(scene)
         self.scene, self.sim, self.kind = scene, sim, scene.fractal
-        self.lay = grid.layout(scene.video.width, scene.video.height)
+        self.lay = grid.plot(scene)
         self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
         self.samples = scene.map.samples
         self.points = self.pixels * self.samples  # one pendulum per point: pixel p's samples are p·samples + s
@@ -131,6 +131,7 @@ class FtleMap(fractal.Map):
         lay, stride = self.lay, self.scene.map.trust_stride
         q = np.percentile(sig, [5, 50, 95]).tolist() if self.sim.t > 0 else [0.0] * 3
         return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
+                "axes": grid.axes_summary(self.scene),
                 "pixels": self.pixels, "samples": self.samples, "sigma_scale_per_s": [self.lo, self.hi],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},

@@ -75,17 +75,6 @@ class Certificate:
             d["lyapunov"] = self.lyapunov
         return d
 
-    def line(self) -> str:
-        """One line for the end of a render."""
-        first, median = self.faithful_until_s, self.median_until_s
-        return (f"faithful until {_t(first, self.duration)} (median {_t(median, self.duration)}, "
-                f"{100 * self.fraction_faithful:.0f} % of {len(self.indices)} pendulums through "
-                f"{self.duration:g} s) at {self.tolerance:g} {self.unit}")
-
-
-def _t(t: float, duration: float) -> str:
-    return f"the end ({duration:g} s)" if t >= duration else f"{t:.2f} s"
-
 
 def subsample(count: int, limit: int = SUBSAMPLE) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, count - 1, min(count, limit))).astype(np.int64))
