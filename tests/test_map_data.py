@@ -87,7 +87,8 @@ def test_the_npz_flip_times_agree_with_the_png_and_with_dop853_on_100_trusted_pi
     name = scene.name
     assert meta["outputs"][f"{name}.npz"] == (tmp_path / name / f"{name}.npz").stat().st_size
     assert render.load_map(tmp_path / name / f"{name}.npz").value.tobytes() == d.value.tobytes()  # file or folder
-    assert (d.colouring, d.unit, d.x_quantity, d.y_quantity, d.samples) == ("flip_time", "s", "theta1", "theta2", 1)
+    assert (d.colouring, d.unit, d.samples) == ("flip_time", "s", 1)
+    assert (d.x_quantity, d.y_quantity, d.x_unit, d.y_unit) == ("theta1", "theta2", "rad", "rad")
     assert d.value.shape == d.cannot_flip.shape == d.trusted.shape == (32, 32, 1) and d.trusted_until.shape == (32, 32)
     assert d.t == pytest.approx((scene.frames - 1) / scene.video.fps)
     # the axes: pixel centres from -π to π, θ2 downwards; every sample starts at its pixel's centre
@@ -142,18 +143,19 @@ def test_a_render_that_fails_as_it_finishes_leaves_no_npz(tmp_path, monkeypatch)
 
 # ---------------------------------------------------------------- supersampling
 
-@pytest.mark.parametrize("samples", [4, 9])
-def test_sub_pixel_starts_split_each_pixel_into_a_regular_grid(samples):
-    scene = small("fractal_flip", 32, 1.0, f"map.samples={samples}")
+@pytest.mark.parametrize("samples, axes", [(4, []), (9, []),
+                                           (4, ['map.x="omega1"', "map.x_range=[-2.0, 3.0]", "map.y_range=[0.5, 0.501]"])])
+def test_sub_pixel_starts_split_each_pixel_into_a_regular_grid(samples, axes):
+    scene = small("fractal_flip", 32, 1.0, f"map.samples={samples}", *axes)
     k = int(round(samples ** 0.5))
     xy = grid.sample_starts(scene).reshape(32, 32, samples, 2)
     centres = grid.starts(scene).reshape(32, 32, 2)
-    assert np.allclose(xy.mean(2), centres, atol=1e-12)  # the samples sit around their pixel's centre
+    assert np.allclose(xy.mean(2), centres, atol=1e-12, rtol=0)  # the samples sit around their pixel's centre
     fine = np.stack([supersample.fine_grid(xy[..., i].ravel(), 32, 32, samples) for i in (0, 1)], -1)
-    # on the samples' own grid they are the pixel centres of a map k times as fine
-    step = 2 * np.pi / (32 * k)
-    assert np.allclose(fine[0, :, 0], -np.pi + (np.arange(32 * k) + 0.5) * step, atol=1e-12)
-    assert np.allclose(fine[:, 0, 1], np.pi - (np.arange(32 * k) + 0.5) * step, atol=1e-12)
+    # on the samples' own grid they are the pixel centres of a map k times as fine, whatever the axes span
+    (_, xlo, xhi), (_, ylo, yhi) = grid.axes_of(scene.map)
+    assert np.allclose(fine[0, :, 0], xlo + (np.arange(32 * k) + 0.5) * (xhi - xlo) / (32 * k), atol=1e-12, rtol=0)
+    assert np.allclose(fine[:, 0, 1], yhi - (np.arange(32 * k) + 0.5) * (yhi - ylo) / (32 * k), atol=1e-12, rtol=0)
     assert np.allclose(fine[..., 0], fine[:1, :, 0]) and np.allclose(fine[..., 1], fine[:, :1, 1])
     assert (supersample.coarse(supersample.fine_grid(np.arange(32 * 32 * samples), 32, 32, samples), 32, 32, samples)
             == np.arange(32 * 32 * samples)).all()
