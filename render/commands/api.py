@@ -1,4 +1,4 @@
-"""The Python API: `load`, `render`, `simulate` and `compare`. The CLI is a thin layer over it.
+"""The Python API: `load`, `render`, `simulate`, `compare` and `load_map`. The CLI is a thin layer over it.
 
 Every check the command line makes before any work lives here, so a notebook gets the same refusals as a
 shell: bad input raises SceneError (the CLI's exit 2) before anything is written, a failure while running
@@ -9,6 +9,7 @@ raises SimulationError or EncodeError (exit 1), the file system's errors are OSE
     result = render.render(scene, out="out")      # a RenderResult: paths, metadata, certificate
     traj = render.simulate(scene)                 # a Trajectory: t, theta/omega or pos/vel, energy
     both = render.compare("rigid_chaos", vary={"integrator.precision": ["f32", "f64"]})  # a split screen
+    pixels = render.load_map("out/fractal_flip")  # a map's NAME.npz: its pixels' flip times, mask, axes
 """
 from __future__ import annotations
 
@@ -175,3 +176,10 @@ def with_table(scene, vary: dict):
     raw = scene.to_dict()
     raw["compare"] = {"vary": vary}
     return dataclasses.replace(scenes.from_dict(raw, scene.source), overrides=scene.overrides)
+
+
+def load_map(path: str | os.PathLike):
+    """A map render's per-pixel data (a MapData, render/maps/data.py): its NAME.npz, or the render's folder
+    OUT/NAME/ that holds it."""
+    from ..maps import data
+    return data.load(path)

@@ -86,7 +86,8 @@ class Inset:
 
 
 def value_text(canvas, kind: str, p: int, t: float) -> str:
-    """What the map says of pixel p at time t, in words."""
+    """What the map says of pixel p at time t, in words (a supersampled pixel: of its first sample)."""
+    p *= canvas.samples  # the pixel's first point (render/maps/fractal.py)
     if kind == "lyapunov":
         return f"σ = {float(canvas.sigma.to_numpy()[p]):.3g} 1/s"
     if kind == "angles":

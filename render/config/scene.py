@@ -110,6 +110,7 @@ class MapSpec:
     epsilon: float
     threshold: float
     trust_stride: int
+    samples: int = 1  # sub-pixel starts per pixel
     x: str = "theta1"  # the axes' quantities and spans (render/physics/grid.py)
     y: str = "theta2"
     x_range: tuple[float, float] = tuple(MAP_AXES["x_range"])
@@ -171,6 +172,8 @@ class Scene:
         for key, default in MAP_AXES.items():  # so are a map's default axes
             if "map" in d and d["map"][key] == default:
                 del d["map"][key]
+        if d.get("map", {}).get("samples") == 1:
+            del d["map"]["samples"]
         blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 

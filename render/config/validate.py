@@ -31,7 +31,9 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
     "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
     "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
     "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
+    "samples": 1,  # sub-pixel starts per pixel (render/physics/grid.py's sample_starts)
 }
+SAMPLES = (1, 4, 9)  # map.samples: a pixel's centre, or a regular 2 x 2 or 3 x 3 split of it
 MAP_AXES = {"x": grid.AXES[0], "y": grid.AXES[1], "x_range": list(grid.RANGE), "y_range": list(grid.RANGE)}
 AXIS_MAX = 1e4  # rad or rad/s: beyond it an angle has wrapped thousands of times and a rate needs µs steps
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
@@ -224,8 +226,16 @@ class Validator:
         thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
         if fractal == "divergence" and thr <= eps:
             self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
-        out = {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096)}
+        out = {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096),
+               "samples": self.samples(d)}
         return {**out, **self.axes(d, system)}
+
+    def samples(self, d) -> int:
+        val = d["map"]["samples"]
+        if isinstance(val, bool) or not isinstance(val, int) or val not in SAMPLES:
+            self.fail("map.samples", f"must be 1, 4 or 9 (a pixel's centre, or a 2 x 2 or 3 x 3 split of it), "
+                      f"got {clip(repr(val))}")
+        return val
 
     def axes(self, d, system) -> dict:
         """[map] x, y (quantities, grid.quantities) and x_range, y_range ([lo, hi], lo < hi)."""
@@ -277,10 +287,15 @@ class Validator:
             if d["pendulums"]["count"] is None:
                 d["pendulums"]["count"] = want
             lay = grid.layout(video["width"], video["height"], SimpleNamespace(**spec))
+            samples = spec["samples"]
+            each = f"{samples} sub-pixel starts" if samples > 1 else "one pendulum"
             if d["pendulums"]["count"] != want:
-                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
-                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video['width']}x"
+                self.fail("pendulums.count", f"a grid has {each} per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if fractal == 'divergence' else ''} in a {video['width']}x"
                           f"{video['height']} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+            if samples > 1 and want > MAX_PENDULUMS:
+                self.fail("map.samples", f"{each} per pixel of a {lay.w}x{lay.h} plot make {want} pendulums, more "
+                          f"than {MAX_PENDULUMS}; use fewer samples or a smaller video")
         elif d["pendulums"]["count"] is None:
             self.fail("pendulums.count", "missing (this key is required)")
         count = self.integer(d, "pendulums", "count", 1, MAX_PENDULUMS)

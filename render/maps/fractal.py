@@ -32,6 +32,12 @@ certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_in
 pendulums, and each pixel's faithful time is the least of its lattice neighbours' (grid.faithful_map). A
 pixel whose claim reaches past that time is drawn desaturated and hatched. Pixels that cannot flip are
 trusted: energy, not the integration, settles them.
+
+**Samples and data.** With map.samples = 4 or 9 a pixel is 4 or 9 sub-pixel starts (grid.sample_starts), the
+map's *points*: each is its own pendulum (with its own twin), with its own event and its own claim against
+the pixel's faithful time, and the pixel shows their colours' mean in linear light (render/maps/supersample.py).
+With one sample, a point is its pixel. result() hands each point's value, claim and cannot-flip mask to the
+map's NAME.npz (render/maps/data.py).
 """
 
 import math
@@ -39,21 +45,12 @@ import math
 import numpy as np
 import taichi as ti
 
+from . import supersample
+from .colours import PENDING_GREY, palette, sin8, untrusted
+from .data import NEVER, PENDING  # the event field's "not happened (yet)" and "cannot happen"
 from ..draw import axes
 from ..physics import grid, integrators, runtime
 from ..draw.font import Font
-
-PENDING = -1.0  # event field: not happened (yet)
-NEVER = -2.0  # cannot happen: below the energy barrier
-# matplotlib's plasma at 9 points, read backwards on the map (early events bright): saturated everywhere,
-# so a desaturated (untrusted) pixel stands apart, and its dark end is blue, not the black of "never"
-PALETTE = ((0.05, 0.03, 0.528), (0.3, 0.01, 0.632), (0.495, 0.012, 0.658), (0.665, 0.139, 0.586),
-           (0.798, 0.28, 0.47), (0.902, 0.425, 0.36), (0.973, 0.586, 0.252), (0.993, 0.772, 0.155),
-           (0.94, 0.975, 0.131))
-STOPS = len(PALETTE)
-PENDING_GREY = 0.24  # a flip map's pixels that may still flip
-HATCH = 5  # pixels between the diagonal lines over untrusted pixels
-
 
 def barriers(masses, lengths, g: float) -> list[float]:
     """B_k = 2 g μ_k l_k: the least energy (zero hanging at rest) with which link k can point straight up."""
@@ -63,42 +60,6 @@ def barriers(masses, lengths, g: float) -> list[float]:
 def time_scale(duration: float) -> tuple[float, float]:
     """The log colour scale's range in s: from 0.1 s (or a quarter of a short video) to the end."""
     return min(0.1, duration / 4), duration
-
-
-@ti.func
-def palette(u):
-    """u in [0, 1] to PALETTE, piecewise linear."""
-    x = ti.min(ti.max(u, 0.0), 1.0) * (STOPS - 1)
-    k = ti.min(ti.cast(ti.floor(x), ti.i32), STOPS - 2)
-    f = x - k
-    c = ti.Vector([0.0, 0.0, 0.0])
-    for j in ti.static(range(STOPS - 1)):
-        if k == j:
-            c = (1.0 - f) * ti.Vector(PALETTE[j]) + f * ti.Vector(PALETTE[j + 1])
-    return c
-
-
-@ti.func
-def sin8(x):
-    """sin(x) to within 1e-4, plenty for a colour byte and about 3x cheaper than libm's call. Reduced to
-    [-pi/2, pi/2], then the Taylor series to x^9 (error < 4e-6 there)."""
-    x = x - 2.0 * math.pi * ti.round(x * (0.5 / math.pi))
-    if x > 0.5 * math.pi:
-        x = math.pi - x
-    elif x < -0.5 * math.pi:
-        x = -math.pi - x
-    x2 = x * x
-    return x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))))
-
-
-@ti.func
-def untrusted(c, x, y):
-    """The mask: most of the colour drained, and a diagonal hatch that shows on dark pixels too."""
-    lum = 0.3 * c[0] + 0.59 * c[1] + 0.11 * c[2]
-    c = 0.75 * (lum + 0.3 * (c - lum))
-    if (x + y) % HATCH == 0:
-        c = ti.Vector([0.1, 0.1, 0.1]) if lum > 0.45 else ti.Vector([0.5, 0.5, 0.5])
-    return c
 
 
 @ti.data_oriented
@@ -111,6 +72,8 @@ class Map(runtime.Launcher):
         v, self.scene, self.sim, self.kind = scene.video, scene, sim, scene.fractal
         self.lay = grid.plot(scene)
         self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.samples = scene.map.samples  # sub-pixel starts per pixel (render/maps/supersample.py)
+        self.points = self.pixels * self.samples  # the starts: pixel p's samples are points p·samples + s
         self.twins = self.kind == "divergence"
         self.lanes = 2 if self.twins else 1  # pendulums per kernel iteration: a pixel, or a pixel and its twin
         self.groups = -(-sim.n // self.lanes)
@@ -119,7 +82,8 @@ class Map(runtime.Launcher):
         self.lo, self.hi = time_scale(v.duration)
         self.log_lo, self.log_span = math.log(self.lo), math.log(self.hi / self.lo)
         self.log_ratio = math.log(self.threshold / self.eps)
-        self.event = runtime.field("fractal.event", ti.f32, self.pixels)
+        self.event = runtime.field("fractal.event", ti.f32, self.points)
+        self.cannot = runtime.field("fractal.cannot_flip", ti.u8, self.points)  # E < B, whatever the colouring
         self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
         self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
         self.font = Font(self.lay.font) if self.lay.font else None
@@ -154,16 +118,29 @@ class Map(runtime.Launcher):
             self.font.draw(out, f"t = {self.sim.t:.2f} s", x, y, colour=axes.INK, ha="right")
         return out
 
+    def result(self) -> dict:
+        """Per point (pixels · samples, in the map's order) at the current frame, for the map's data
+        (render/maps/data.py): `value`, what the colouring measures (the event time in s, PENDING or NEVER; the
+        angles map: the links' angles, (points, links)); `claim`, how far along its trajectory the colour
+        speaks for (the trust mask compares it with the pixel's faithful time); `cannot_flip`, E < B."""
+        ev, t = self.event.to_numpy(), np.float32(self.sim.t)
+        if self.kind == "angles":
+            value, claim = self.sim.q.to_numpy(), np.full(self.points, t)
+        else:
+            value, claim = ev, np.where(ev >= 0, ev, np.where(ev == NEVER, np.float32(0), t))
+        return {"value": value, "claim": claim, "cannot_flip": self.cannot.to_numpy().astype(bool)}
+
     def summary(self) -> dict:
-        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not."""
-        ev, until = self.event.to_numpy(), self.until.to_numpy()
+        """For metadata.json: the plot, the lattice, and how many points (pixels, or their samples) had their
+        event, trusted or not."""
+        ev, until = self.event.to_numpy(), np.repeat(self.until.to_numpy(), self.samples)
         t = np.float32(self.sim.t)
         done, pending = ev >= 0, ev == PENDING
         claim = np.where(done, ev, t)
         lay, stride = self.lay, self.scene.map.trust_stride
         return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
                 "axes": grid.axes_summary(self.scene),
-                "pixels": self.pixels, "time_scale_s": [self.lo, self.hi],
+                "pixels": self.pixels, "samples": self.samples, "time_scale_s": [self.lo, self.hi],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
                 "cannot_flip": int((ev == NEVER).sum()), "events": int(done.sum()),
@@ -187,20 +164,23 @@ class Map(runtime.Launcher):
 
     # ------------------------------------------------------------ kernels
     @ti.func
-    def pixel(self, i):
-        """The pixel of pendulum i."""
-        p = i
+    def point(self, i):
+        """The point (a pixel's sample) of pendulum i."""
+        j = i
         if ti.static(self.twins):
-            p = i // 2
-        return p
+            j = i // 2
+        return j
 
     @ti.kernel
     def fractal_setup(self):
-        for p in range(self.pixels):
-            self.event[p] = PENDING
+        for j in range(self.points):
+            i = j * self.lanes  # the point's own pendulum, not its twin
+            below = self.sim.energy(self.sim.q[i], self.sim.v[i]) < self.barrier
+            self.cannot[j] = ti.cast(below, ti.u8)
+            self.event[j] = PENDING
             if ti.static(self.kind == "flip_time"):
-                if self.sim.energy(self.sim.q[p], self.sim.v[p]) < self.barrier:
-                    self.event[p] = NEVER
+                if below:
+                    self.event[j] = NEVER
 
     @ti.func
     def live(self, g):
@@ -208,7 +188,7 @@ class Map(runtime.Launcher):
         live = 0
         for lane in ti.static(range(self.lanes)):
             i = g * self.lanes + lane
-            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+            if i < self.sim.n and self.event[self.point(i)] == PENDING:
                 live = 1
         return live
 
@@ -249,7 +229,7 @@ class Map(runtime.Launcher):
         """Events within the step from (q, v) at t to (q1, v1) at t + h, at their interpolated times."""
         for lane in ti.static(range(0, self.lanes, 2 if self.twins else 1)):
             i = g * self.lanes + lane
-            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+            if i < self.sim.n and self.event[self.point(i)] == PENDING:
                 frac = 2.0
                 if ti.static(self.twins):
                     d0, d1 = self.distance(q, v, lane), self.distance(q1, v1, lane)
@@ -261,7 +241,7 @@ class Map(runtime.Launcher):
                         if b > math.pi and a <= math.pi:
                             frac = ti.min(frac, (math.pi - a) / (b - a))
                 if frac <= 1.0:
-                    self.event[self.pixel(i)] = t + frac * h
+                    self.event[self.point(i)] = t + frac * h
 
     @ti.func
     def distance(self, q, v, lane: ti.template()):
@@ -288,31 +268,48 @@ class Map(runtime.Launcher):
 
     @ti.kernel
     def fractal_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
-        """Every pixel of the plot; one claims its trajectory up to min(t, its event), trusted up to its
-        faithful time."""
+        """Every pixel of the plot: its one sample's colour, or the mean of its samples' in linear light."""
         for r, c in ti.ndrange(self.h, self.w):
-            p = r * self.w + c
-            ev = self.event[p]
-            claim = t
-            col = ti.Vector([0.0, 0.0, 0.0])
-            if ti.static(self.kind == "angles"):
-                q = self.sim.q[p]
-                col = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
-            else:
-                if ev >= 0.0:
-                    col, claim = self.time_colour(ev), ev
-                elif ev == NEVER:
-                    claim = 0.0  # settled by energy, not by the integration
-                elif ti.static(self.twins):
-                    a, b = 2 * p, 2 * p + 1
-                    col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
-                                                + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
-                else:
-                    col = ti.Vector([PENDING_GREY] * 3)
-            if claim > self.until[p]:
-                col = untrusted(col, c, r)
+            col = self.pixel_colour(r * self.w + c, t, c, r)
             for k in ti.static(range(3)):
                 out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+
+    @ti.func
+    def pixel_colour(self, p, t, c, r):
+        """Pixel p's colour (column c, row r): its one point's, or the mean of its samples' in linear light."""
+        col = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(self.samples == 1):
+            col = self.point_colour(p, p, t, c, r)
+        else:
+            for s in ti.static(range(self.samples)):
+                col += supersample.linear(self.point_colour(p * self.samples + s, p, t, c, r))
+            col = supersample.encode(col / self.samples)
+        return col
+
+    @ti.func
+    def point_colour(self, j, p, t, c, r):
+        """Point j's colour (of pixel p, at column c and row r): it claims its trajectory up to min(t, its
+        event), trusted up to the pixel's faithful time."""
+        ev = self.event[j]
+        claim = t
+        col = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(self.kind == "angles"):
+            q = self.sim.q[j]
+            col = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
+        else:
+            if ev >= 0.0:
+                col, claim = self.time_colour(ev), ev
+            elif ev == NEVER:
+                claim = 0.0  # settled by energy, not by the integration
+            elif ti.static(self.twins):
+                a, b = 2 * j, 2 * j + 1
+                col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
+                                            + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
+            else:
+                col = ti.Vector([PENDING_GREY] * 3)
+        if claim > self.until[p]:
+            col = untrusted(col, c, r)
+        return col
 
     @ti.kernel
     def fractal_swatch(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), x0: ti.i32, y0: ti.i32, w: ti.i32,

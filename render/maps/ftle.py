@@ -27,7 +27,9 @@ the colour bar is in 1/s. The energy barrier (render/maps/fractal.py: a pendulum
 is the black curve E(θ1, θ2) = B: the pixels inside it next to one outside. Inside, the motion is bounded
 away from the top, and σ is still measured there, not blacked out (it is mostly small: regular motion).
 The trust mask is the other maps': every pixel claims its trajectory up to t, and is desaturated and
-hatched past the faithful time of its lattice neighbours.
+hatched past the faithful time of its lattice neighbours. With map.samples = 4 or 9 each sample (point) carries
+its own tangent vectors and σ, the barrier's curve is found on the samples' own finer grid (a sample on it is
+black), and a pixel shows its samples' colours averaged as render/maps/fractal.py's map does.
 
 **Trig.** Taichi's forward mode cannot differentiate render/physics/sincos.py's inline sin/cos, so the tangent
 kernel steps a libm twin of the system (tangent.libm_twin) and its primal is the map's state. The preset
@@ -43,7 +45,7 @@ in the vectorised loop is the way to close that gap.
 import numpy as np
 import taichi as ti
 
-from . import fractal
+from . import colours, fractal, supersample
 from ..physics import grid, integrators, runtime
 from ..draw.font import Font
 from ..physics.tangent import check_method, libm_twin, scalarized
@@ -63,20 +65,22 @@ class FtleMap(fractal.Map):
         self.scene, self.sim, self.kind = scene, sim, scene.fractal
         self.lay = grid.plot(scene)
         self.w, self.h, self.pixels = self.lay.w, self.lay.h, self.lay.pixels
+        self.samples = scene.map.samples
+        self.points = self.pixels * self.samples  # one pendulum per point: pixel p's samples are p·samples + s
         self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
         self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
         self.twin = libm_twin(sim)
         self.k = 2 * sim.D  # tangent vectors per pixel: the state's dimension (4 for the double pendulum)
-        real, n, D = runtime.real(), self.k * self.pixels, self.k  # one kernel element per tangent vector
+        real, n, D = runtime.real(), self.k * self.points, self.k  # one kernel element per tangent vector
         # dx: a zero offset to the state, whose duals are the columns of M; out: the frame's end and its duals
         self.dx = ti.Vector.field(D, real, shape=n, needs_dual=True)
         self.out = ti.Vector.field(D, real, shape=n, needs_dual=True)
         runtime.allocated["ftle.tangents"] = 4 * n * D * (8 if real == ti.f64 else 4)  # the two and their duals
         self.loss = ti.field(real, shape=(), needs_dual=True)  # FwdMode's required (unused) loss and param:
         self.unit = ti.field(real, shape=(), needs_dual=True)  # the seeds are dx's duals, set per element
-        self.log_scale = runtime.field("ftle.log_scale", real, self.pixels)  # L
-        self.sigma = runtime.field("ftle.sigma", real, self.pixels)  # σ_t as last drawn
-        self.edge = runtime.field("ftle.barrier", ti.u8, self.pixels)
+        self.log_scale = runtime.field("ftle.log_scale", real, self.points)  # L
+        self.sigma = runtime.field("ftle.sigma", real, self.points)  # σ_t as last drawn
+        self.edge = runtime.field("ftle.barrier", ti.u8, self.points)
         self.until = runtime.field("fractal.faithful_until", ti.f32, self.pixels)
         self.until.from_numpy(grid.faithful_map(scene, cert.until_s).ravel().astype(np.float32))
         self.barrier = min(fractal.barriers(sim.masses, sim.lengths, sim.g))
@@ -86,15 +90,17 @@ class FtleMap(fractal.Map):
         self.restart()
 
     def barrier_curve(self) -> np.ndarray:
-        """Per pixel, 1 where E < B and a 4-neighbour has E ≥ B: the barrier's curve, on its inner side."""
+        """Per point, 1 where E < B and a 4-neighbour has E ≥ B: the barrier's curve, on its inner side, on the
+        samples' own grid (render/maps/supersample.py), so that supersampling draws it finer, not wider."""
         self.launch("ftle_energy")
-        inside = (self.sigma.to_numpy() < self.barrier).reshape(self.h, self.w)
+        self.inside = self.sigma.to_numpy() < self.barrier  # the cannot-flip mask, for the map's data
+        inside = supersample.fine_grid(self.inside, self.h, self.w, self.samples)
         out = np.zeros_like(inside)
         out[1:] |= ~inside[:-1]
         out[:-1] |= ~inside[1:]
         out[:, 1:] |= ~inside[:, :-1]
         out[:, :-1] |= ~inside[:, 1:]
-        return (inside & out).ravel().astype(np.uint8)
+        return supersample.coarse(inside & out, self.h, self.w, self.samples).astype(np.uint8)
 
     def restart(self):
         """M = I and L = 0 at every pixel, from the system's current (initial) state."""
@@ -112,15 +118,21 @@ class FtleMap(fractal.Map):
         m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
         return m, self.log_scale.to_numpy().astype(np.float64)
 
+    def result(self) -> dict:
+        """Per point at the current frame, as fractal.Map.result(): σ_t in 1/s as last drawn; every point
+        claims its trajectory up to t."""
+        return {"value": self.sigma.to_numpy(), "claim": np.full(self.points, np.float32(self.sim.t)),
+                "cannot_flip": self.inside.copy()}
+
     def summary(self) -> dict:
-        """For metadata.json: the plot, the lattice, σ's spread and how many pixels are trusted."""
+        """For metadata.json: the plot, the lattice, σ's spread (over points) and how many pixels are trusted."""
         sig, until = self.sigma.to_numpy(), self.until.to_numpy()
         trusted = np.float32(self.sim.t) <= until
         lay, stride = self.lay, self.scene.map.trust_stride
         q = np.percentile(sig, [5, 50, 95]).tolist() if self.sim.t > 0 else [0.0] * 3
         return {"colouring": self.kind, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
                 "axes": grid.axes_summary(self.scene),
-                "pixels": self.pixels, "sigma_scale_per_s": [self.lo, self.hi],
+                "pixels": self.pixels, "samples": self.samples, "sigma_scale_per_s": [self.lo, self.hi],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
                 "t_s": self.sim.t, "sigma_percentiles_5_50_95_per_s": q, "trusted": int(trusted.sum()),
@@ -130,22 +142,22 @@ class FtleMap(fractal.Map):
     @ti.kernel
     def ftle_energy(self):
         """Each pixel's energy, into sigma for now (barrier_curve reads it once)."""
-        for p in range(self.pixels):
-            self.sigma[p] = self.sim.energy(self.sim.q[p], self.sim.v[p])
+        for j in range(self.points):
+            self.sigma[j] = self.sim.energy(self.sim.q[j], self.sim.v[j])
 
     @ti.kernel
     def ftle_setup(self):
-        for e in range(self.k * self.pixels):
+        for e in range(self.k * self.points):
             self.dx[e] = ti.Vector.zero(float, self.k)
             self.dx.dual[e] = ti.Vector.unit(self.k, e % self.k, float)
-        for p in range(self.pixels):
-            self.log_scale[p], self.sigma[p] = 0.0, 0.0
+        for j in range(self.points):
+            self.log_scale[j], self.sigma[j] = 0.0, 0.0
 
     @ti.kernel
     def ftle_frame(self, sys: ti.template(), substeps: ti.i32, h: float):
-        """One frame of every pixel, four times: lane e % k with column e % k of its M as the state's dual."""
+        """One frame of every point, four times: lane e % k with column e % k of its M as the state's dual."""
         D = ti.static(self.sim.D)
-        for e in range(self.k * self.pixels):
+        for e in range(self.k * self.points):
             p, d = e // self.k, self.dx[e]
             q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
             v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
@@ -157,7 +169,7 @@ class FtleMap(fractal.Map):
     def ftle_renormalise(self):
         """The new state (lane 0's primal), M = the frame's images over their largest entry m, L += ln m."""
         D, K = ti.static(self.sim.D, self.k)
-        for p in range(self.pixels):
+        for p in range(self.points):
             m = 0.0
             for k in ti.static(range(K)):
                 m = ti.max(m, ti.abs(self.out.dual[K * p + k]).max())
@@ -173,7 +185,7 @@ class FtleMap(fractal.Map):
 
     @ti.func
     def log_smax(self, p):
-        """ln s_max(M) of pixel p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
+        """ln s_max(M) of point p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
         K = ti.static(self.k)
         m = ti.Matrix.cols([self.dx.dual[K * p + k] for k in ti.static(range(K))])
         b = m.transpose() @ m
@@ -189,23 +201,29 @@ class FtleMap(fractal.Map):
         return 0.5 * ti.log(x.dot(b @ x) / x.norm_sqr())
 
     @ti.func
+    def point_colour(self, j, p, t, c, r):
+        """Point j's colour (of pixel p, at column c and row r), σ_t kept in sigma."""
+        s = 0.0
+        if t > 0.0:
+            s = (self.log_scale[j] + self.log_smax(j)) / t
+        self.sigma[j] = s
+        col = colours.palette(s / SIGMA_MAX)
+        if self.edge[j]:
+            col = ti.Vector([0.0, 0.0, 0.0])
+        if t > self.until[p]:
+            col = colours.untrusted(col, c, r)
+        return col
+
+    @ti.func
     def bar_colour(self, u):
         """The colour bar's colour at u in [0, 1] (bottom to top): σ = u·SIGMA_MAX."""
-        return fractal.palette(u)
+        return colours.palette(u)
 
     @ti.kernel
     def ftle_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
-        """σ_t of every pixel, on the linear scale; the barrier's curve black; past the faithful time, masked."""
+        """σ_t of every pixel, on the linear scale (of each sample, their colours averaged in linear light); the
+        barrier's curve black; past the faithful time, masked."""
         for r, c in ti.ndrange(self.h, self.w):
-            p = r * self.w + c
-            s = 0.0
-            if t > 0.0:
-                s = (self.log_scale[p] + self.log_smax(p)) / t
-            self.sigma[p] = s
-            col = fractal.palette(s / SIGMA_MAX)
-            if self.edge[p]:
-                col = ti.Vector([0.0, 0.0, 0.0])
-            if t > self.until[p]:
-                col = fractal.untrusted(col, c, r)
+            col = self.pixel_colour(r * self.w + c, t, c, r)
             for k in ti.static(range(3)):
                 out[self.lay.y0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)

@@ -13,10 +13,12 @@ pendulum count of a grid from it), the systems (which start from it) and the map
 - **Precision**: a window so narrow that f32 cannot tell neighbouring pixels' starts well apart (a step under
   F32_STEPS f32 ulps of the largest value on the axis) runs in f64: see f64_reason().
   A divergence map integrates a twin beside each pixel: pendulums 2p and 2p + 1, the twin ε further on the
-  last link (as a fan spreads it), so a pair shares a lane group and a cache line.
+  last link (as a fan spreads it), so a pair shares a lane group and a cache line. With map.samples = 4 or 9,
+  each pixel is a 2 × 2 or 3 × 3 block of sub-pixel starts instead (sample_starts()), one pendulum each (and
+  a twin each), pixel by pixel.
 - **The trust lattice**: every trust_stride-th pixel in both directions, offset by half a stride. The
-  certificate (render/trust/certify.py) runs on exactly these pixels (both pendulums of a pair), and each pixel's
-  faithful time is the least of its (up to) four surrounding lattice samples: see faithful_map().
+  certificate (render/trust/certify.py) runs on exactly these pixels (every sample, both pendulums of a pair),
+  and each pixel's faithful time is the least of its (up to) four surrounding lattice samples: see faithful_map().
 """
 from __future__ import annotations
 
@@ -124,8 +126,10 @@ def layout(width: int, height: int, spec=None) -> Layout:
 
 
 def pendulums(width: int, height: int, fractal: str | None, spec=None) -> int:
-    """A grid's pendulum count: one per pixel of the plot, two for a divergence map (pixel and twin)."""
-    return layout(width, height, spec).pixels * (2 if fractal == "divergence" else 1)
+    """A grid's pendulum count: map.samples per pixel of the plot (one without a [map]), two for each in a
+    divergence map (sample and twin)."""
+    samples = 1 if spec is None else spec.samples
+    return layout(width, height, spec).pixels * samples * (2 if fractal == "divergence" else 1)
 
 
 def plot(scene) -> Layout:
@@ -170,10 +174,27 @@ def starts(scene) -> np.ndarray:
     return np.stack([np.tile(x, lay.h), np.repeat(y, lay.w)], axis=1)
 
 
-def grid_state(scene, th: np.ndarray, w: np.ndarray):
-    """The grid layout's initial angles and rates (each (count, links)): the plot's starts on its two axes'
-    quantities, every other coordinate as the preset states it; with twins, each pixel's twin ε on."""
+def sample_starts(scene) -> np.ndarray:
+    """Per sample of every pixel, the (x, y) values it starts at: (pixels · samples, 2), pixel by pixel as
+    starts() orders them, and within a pixel its map.samples = k² samples row by row from the top left, at the
+    centres of a regular k × k split of the pixel. k = 1 is the pixel's centre. The pixel's extent is the
+    spacing of starts()' centres, so the samples follow whatever the axes span."""
     xy = starts(scene)
+    k = math.isqrt(scene.map.samples)
+    if k == 1:
+        return xy
+    lay = plot(scene)
+    centre = xy.reshape(lay.h, lay.w, 2)
+    dx, dy = centre[0, 1, 0] - centre[0, 0, 0], centre[1, 0, 1] - centre[0, 0, 1]  # a column, a row on
+    f = (np.arange(k) + 0.5) / k - 0.5
+    off = np.stack([np.tile(f * dx, k), np.repeat(f * dy, k)], axis=1)  # (k², 2): sample (b, a) is b * k + a
+    return (xy[:, None, :] + off[None]).reshape(-1, 2)
+
+
+def grid_state(scene, th: np.ndarray, w: np.ndarray):
+    """The grid layout's initial angles and rates (each (count, links)): the plot's (sub-pixel) starts on its two
+    axes' quantities, every other coordinate as the preset states it; with twins, each sample's twin ε on."""
+    xy = sample_starts(scene)
     twins = scene.fractal == "divergence"
     for (q, *_), col in zip(axes_of(scene.map), xy.T):
         target = th if q.startswith("theta") else w
@@ -192,11 +213,12 @@ def lattice_axis(n: int, stride: int) -> np.ndarray:
 
 
 def trust_indices(scene) -> np.ndarray:
-    """The pendulums the certificate runs on for a map: the lattice's pixels (with their twins)."""
-    lay = plot(scene)
+    """The pendulums the certificate runs on for a map: every sample of the lattice's pixels (with their twins)."""
+    lay, n = plot(scene), scene.map.samples
     rows = lattice_axis(lay.h, scene.map.trust_stride)
     cols = lattice_axis(lay.w, scene.map.trust_stride)
     pix = (rows[:, None] * lay.w + cols[None, :]).ravel()
+    pix = (pix[:, None] * n + np.arange(n)).ravel()
     if scene.fractal == "divergence":
         pix = np.stack([2 * pix, 2 * pix + 1], axis=1).ravel()
     return pix.astype(np.int64)
@@ -206,8 +228,9 @@ def faithful_map(scene, until_s: np.ndarray) -> np.ndarray:
     """Per pixel of the plot (h, w), the time until which its integration is estimated faithful, from the
     certificate's per-pendulum times on the lattice (in trust_indices() order).
 
-    A pixel takes the least of the (up to) four lattice samples around it (the nearest ones at the edges),
-    a pair the lesser of pixel and twin. The least, not an interpolation: in the chaotic region neighbours
+    A lattice pixel's time is the least of its samples' (and their twins'). A pixel takes the least of the (up
+    to) four lattice samples around it (the nearest ones at the edges), a pair the lesser of pixel and twin. The
+    least, not an interpolation: in the chaotic region neighbours
     part within seconds, so a sample speaks for its surroundings only statistically, and a mask must err
     towards distrust. tests/test_fractal.py measures how often it errs the other way against a shadow at
     every pixel."""
@@ -217,11 +240,11 @@ def faithful_map(scene, until_s: np.ndarray) -> np.ndarray:
     until = np.asarray(until_s, dtype=np.float64)
     if scene.fractal == "divergence":
         until = np.minimum(until[0::2], until[1::2])
-    samples = until.reshape(len(rows), len(cols))
+    at = until.reshape(len(rows), len(cols), scene.map.samples).min(-1)
     r0, r1 = _neighbours(lay.h, rows)
     c0, c1 = _neighbours(lay.w, cols)
-    out = np.minimum(samples[r0][:, c0], samples[r0][:, c1])
-    return np.minimum(out, np.minimum(samples[r1][:, c0], samples[r1][:, c1]))
+    out = np.minimum(at[r0][:, c0], at[r0][:, c1])
+    return np.minimum(out, np.minimum(at[r1][:, c0], at[r1][:, c1]))
 
 
 def _neighbours(n: int, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -136,6 +136,23 @@ def open_source(scene, arch: str = "cpu", threads: int | None = None):
     return SplitScreen(scene, lambda variant: record(variant, arch, threads), arch, threads)
 
 
+@contextmanager
+def map_data(src, out_dir: Path):
+    """A map's NAME.npz (render/maps/data.py), its pixels' data at the last frame, written beside the video
+    before the block and published after it succeeds (removed if it fails); yields the {file: bytes} it adds
+    to the outputs, filled once published. Nothing for a fan."""
+    written = {}
+    if not src.scene.fractal:
+        yield written
+        return
+    from ..maps import data
+    path = out_dir / f"{src.name}.npz"
+    with replacing(path, suffix=".npz") as tmp:  # savez wants the .npz
+        np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
+        yield written
+    written[path.name] = path.stat().st_size
+
+
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
            frame_hook=None) -> dict:
     """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
@@ -167,7 +184,9 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()
-            sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
+            with map_data(src, out_dir) as data:  # published once the videos are
+                sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
+            sizes.update(data)
             timings["encode"] += time.perf_counter() - t
         except BaseException:
             enc.abort()
