@@ -161,7 +161,7 @@ def test_skipped_frames_leave_the_path_that_stamping_every_frame_leaves(name):
         want = ref.draw(None, f / scene.video.fps)
         assert got.tobytes() == want.tobytes(), f"video frame {f}"
         drawn += 1
-    assert drawn == sum(map(bool, frames.repeats)) == 20 and "path_pixels" in launches
+    assert drawn == sum(map(bool, frames.repeats)) == 20 and "trail_path_pixels" in launches
 
 
 def test_gap_is_the_longest_run_of_skipped_frames():

@@ -126,7 +126,7 @@ class Canvas(runtime.Launcher):
         if self.tracing:
             if self.skipped == self.path.shape[0]:
                 raise ValueError(f"more than {self.skipped} frames skipped in a row: follow() was told fewer")
-            self.launch("path_pixels", self.skipped)
+            self.launch("trail_path_pixels", self.skipped)
             self.skipped += 1
 
     def restart(self):
@@ -281,7 +281,7 @@ class Canvas(runtime.Launcher):
                 self.pos[i, j] = self.pixel(pts, j)
 
     @ti.kernel
-    def path_pixels(self, slot: ti.i32):
+    def trail_path_pixels(self, slot: ti.i32):
         """Where the last bob is at a skipped frame (follow()), in pixels."""
         ti.loop_config(serialize=self.serial)
         for i in range(self.n):
@@ -296,12 +296,13 @@ class Canvas(runtime.Launcher):
             p = self.pos[i, self.tip]  # the last bob leaves the trail
             a = p if first else self.last[i]
             c = self.ink(i, 0.9, 0.0) * self.trail_light
-            if ti.static(self.follows):
-                for s in range(skipped):
-                    b = self.path[s, i]
-                    self.segment(self.trail, self.lit, a, b, self.lw, c, True)
-                    a = b
-            self.segment(self.trail, self.lit, a, p, self.lw, c, True)
+            for s in range(skipped + 1):  # one call of segment(), which is inlined: half the code to compile
+                b = p
+                if ti.static(self.follows):
+                    if s < skipped:
+                        b = self.path[s, i]
+                self.segment(self.trail, self.lit, a, b, self.lw, c, True)
+                a = b
             self.last[i] = p
 
     @ti.kernel
