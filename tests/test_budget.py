@@ -143,7 +143,7 @@ def test_the_quality_pilots_count_and_the_costliest_choice_is_assumed():
     and the render at the most expensive setting the pilots could choose."""
     from render.trust import quality
     scene = api.load("elastic_fan", quality="high")
-    plan = registry.get(scene.system)(scene, allocate=False)
+    plan = registry.get(scene.system)(scene)
     cands = quality.offered(scene, plan)
     worst = max(cands, key=lambda c: quality.cost(c, scene.video.fps))
     est = estimate.estimate(scene, RATES)

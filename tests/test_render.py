@@ -8,7 +8,7 @@ import pytest
 
 from conftest import SMALL_FPS, SMALL_H, SMALL_SECONDS, SMALL_W, out_folder, run_cli, small_scene
 from render.config.scene import list_presets, load
-from render.physics.system import DEFAULT_MAX_DRIFT
+from render.physics.integrators import DEFAULT_MAX_DRIFT
 
 
 PRESETS = [p.stem for p in list_presets()]

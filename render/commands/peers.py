@@ -220,7 +220,7 @@ def matplotlib_figure(scene):
 
     from ..physics import reference, registry
 
-    plan = registry.get(scene.system)(scene, allocate=False)  # the step and the initial state, no Taichi
+    plan = registry.get(scene.system)(scene)  # the step and the initial state, no Taichi
     q, v = (a.T.copy() for a in reference.initial_state(scene))
     v_ = scene.video
     fig = plt.figure(figsize=(v_.width / 100, v_.height / 100), dpi=100, facecolor="black")

@@ -50,7 +50,7 @@ GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 un
 
 def check(scene, system, out: Path | None, simulate: bool = False):
     """Refuse `scene` if its memory, output or time exceed the limits; return its time estimate. `system` is
-    its System class (for the size of its state); `out` is where the output goes (a folder, or the .npz's
+    its class (registry.get: for the size of its state); `out` is where the output goes (a folder, or the .npz's
     folder; its bench/rates.json gives this machine's rates), None when nothing is written (the API's
     simulate without a file)."""
     from . import estimate as estimates  # it plans Systems, and system.py imports this module

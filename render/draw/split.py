@@ -183,7 +183,7 @@ class SplitScreen:
         self.scene, self.name, self.frames = scene, scene.name, scene.frames
         variants = scene.variants()
         for v in variants:  # every variant's step, refused (a pinned dt beyond its limit) before any is run
-            registry.get(v.system)(v, allocate=False)
+            registry.get(v.system)(v)
         self.runs = [record(v) for v in variants]  # pass 1, each in its own precision
         self.ref = finest(self.runs)
         v = scene.video

@@ -10,7 +10,7 @@ The preset key `fractal` picks the colouring:
 
 Events are found at every substep (linearly interpolated within it), not at frame times, and a pixel whose
 event has happened is no longer integrated: its colour is settled. Pixels are advanced by the system's own
-integrator (integrators.step on the system's force, lane matrices as in System.advance): no physics here.
+integrator (steps.step on the system's force, lane matrices as in System.advance): no physics here.
 
 **Which pixels cannot flip.** With angles from the hanging position, bob i at height −Σ_{j≤i} l_j cos θ_j and
 μ_k = m_k + ... + m_n the mass at or below link k, the potential energy (zero hanging at rest) is
@@ -49,7 +49,7 @@ from . import supersample
 from .colours import PENDING_GREY, palette, sin8, untrusted
 from .data import NEVER, PENDING  # the event field's "not happened (yet)" and "cannot happen"
 from ..draw import axes
-from ..physics import grid, integrators, runtime
+from ..physics import grid, runtime, steps
 from ..draw.font import Font
 
 def barriers(masses, lengths, g: float) -> list[float]:
@@ -217,7 +217,7 @@ class Map(runtime.Launcher):
             if self.live(g):
                 q, v = self.gather(g)
                 for s in range(substeps):
-                    q1, v1 = integrators.step(self.sim, q, v, h)
+                    q1, v1 = steps.step(self.sim, q, v, h)
                     self.events(g, q, v, q1, v1, t0 + s * h, h)
                     q, v = q1, v1
                     if not self.live(g):

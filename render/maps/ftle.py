@@ -46,7 +46,7 @@ import numpy as np
 import taichi as ti
 
 from . import colours, fractal, supersample
-from ..physics import grid, integrators, runtime
+from ..physics import grid, runtime, steps
 from ..draw.font import Font
 from ..physics.tangent import check_method, libm_twin, scalarized
 
@@ -162,7 +162,7 @@ class FtleMap(fractal.Map):
             q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
             v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
             for _ in range(substeps):
-                q, v = integrators.step(sys, q, v, h)
+                q, v = steps.step(sys, q, v, h)
             self.out[e] = ti.Vector([q[c, 0] for c in ti.static(range(D))] + [v[c, 0] for c in ti.static(range(D))])
 
     @ti.kernel

@@ -24,8 +24,8 @@ import gc
 import sys
 import time
 
-from . import registry, runtime
-from .system import DEFAULT_MAX_DRIFT
+from . import registry
+from .integrators import DEFAULT_MAX_DRIFT
 
 
 class Run:
@@ -37,6 +37,10 @@ class Run:
 
     def __init__(self, scene, arch: str = "cpu", threads: int | None = None, subset=None,
                  precision: str | None = None, keep_log: bool = False):
+        # Taichi is imported with the first Run, not with this module: the certificate's and the quality
+        # levels' modules import Run, and the run-time estimate reads their sizes without running anything.
+        from . import runtime
+
         self.scene = scene
         self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log)  # the one in use
         self.generation = runtime.generation()
@@ -45,6 +49,8 @@ class Run:
     @property
     def current(self) -> bool:
         """Whether Taichi still runs the fields this run was built with."""
+        from . import runtime
+
         return self.generation == runtime.generation()
 
     def frames(self, count: int | None = None, *, substeps: int | None = None, h: float | None = None,
@@ -89,7 +95,8 @@ _built: list = []  # (generation, constants, system, bytes of its fields by name
 def build(scene, subset=None, precision: str | None = None):
     """The scene's system in the current runtime: a free one built earlier with the same constants, loaded
     with this scene's start, or a new one."""
-    plan = registry.get(scene.system)(scene, subset, allocate=False)  # the step and the constants, no field
+    from . import runtime
+    plan = registry.kernels(scene.system)(scene, subset, allocate=False)  # the step and the constants, no field
     key = constants(plan, precision or scene.integrator.precision)
     _built[:] = [b for b in _built if b[0] == runtime.generation()]  # a restart freed the others' fields
     same = [entry for entry in _built if key is not None and entry[1] == key]
@@ -104,7 +111,7 @@ def build(scene, subset=None, precision: str | None = None):
                 runtime.allocated[name] = runtime.allocated.get(name, 0) + size
             return sim
     before = dict(runtime.allocated)
-    sim = registry.get(scene.system)(scene, subset)
+    sim = registry.kernels(scene.system)(scene, subset)
     if key is not None:
         _built.append((runtime.generation(), key, sim,
                        {k: v - before.get(k, 0) for k, v in runtime.allocated.items() if v != before.get(k, 0)}))

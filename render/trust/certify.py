@@ -127,7 +127,7 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
         indices = subsample(scene.pendulums.count)
     shadow_first = scene.integrator.precision != "f64"  # then the render's own init comes last
     if shadow_first:
-        plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)  # the step only
+        plan = registry.get(scene.system)(scene, subset=indices[:1])  # the step only
         ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads)
     run = Run(scene, arch, threads, subset=indices)
     main = record(run, scene.frames, watch=True)  # a blow-up, not an untrue run: the watchdog says so
