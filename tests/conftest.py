@@ -47,7 +47,8 @@ def pytest_sessionfinish(session, exitstatus):
 # rewriting item._nodeid, which pytest 9 no longer reads, so both workers rendered every preset.)
 SHARE_A_WORKER = {"test_golden.py": "preset_renders", "test_render.py": "preset_renders"}
 HEAVY_FIRST = ("test_accuracy_cmd.py", "test_golden.py", "test_render.py", "test_bench.py", "test_certify.py",
-               "test_compare.py", "test_fractal.py", "test_integrators.py", "test_step_limit.py", "test_batch.py",
+               "test_compare.py", "test_fractal.py", "test_map_data.py", "test_explore.py", "test_map_axes.py",
+               "test_integrators.py", "test_step_limit.py", "test_batch.py",
                "test_hard_cases.py", "test_api.py", "test_hardening.py", "test_fuzz.py", "test_lyapunov.py",
                "test_ftle.py", "test_poincare.py", "test_glow.py", "test_refusals.py", "test_bad_input.py")
 

@@ -48,7 +48,7 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
         val = at(rep, key)
         assert isinstance(val, (int, float)) and not isinstance(val, bool), (key, val)
         assert math.isfinite(val) and val > 0, (key, val)
-    # DESIGN.md: fractal_fps per colouring, as a dict; each map rendered at 720p
+    # docs/performance.md: fractal_fps per colouring, as a dict; each map rendered at 720p
     assert set(rep["fractal_fps"]) == {"angles", "flip_time", "divergence", "lyapunov"}
     assert all(math.isfinite(v) and v > 0 for v in rep["fractal_fps"].values()), rep["fractal_fps"]
     assert all(f["map"]["plot"]["width"] > 600 for f in rep["fractal"].values())

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from conftest import make_scene, run_cli
-from render.commands import api, cli, comparison
+from render.commands import api, cli
 from render.config import budget, estimate
 from render.physics import keys, registry, runtime
 from render.video import pipeline
@@ -118,7 +118,7 @@ def test_a_comparison_counts_the_sum_of_its_panels(tmp_path):
             "pendulums.count=100000", "--set", "video.duration=10"]
     refused_fast(argv, tmp_path / "out", "rigid_chaos.toml", "pendulums.count, video.duration: 4 panels estimated",
                  "draw+encode")
-    scene = comparison.with_table(api.load("rigid_chaos", "pendulums.count=100000", "video.duration=10"),
+    scene = api.with_table(api.load("rigid_chaos", "pendulums.count=100000", "video.duration=10"),
                                   {"integrator.dt": [1e-3, 5e-4, 2.5e-4, 2e-3]})
     from render.draw.split import layout
     _, _, w, h = layout(scene.video.width, scene.video.height, 4)[0]
@@ -143,7 +143,7 @@ def test_the_quality_pilots_count_and_the_costliest_choice_is_assumed():
     and the render at the most expensive setting the pilots could choose."""
     from render.trust import quality
     scene = api.load("elastic_fan", quality="high")
-    plan = registry.get(scene.system)(scene, allocate=False)
+    plan = registry.get(scene.system)(scene)
     cands = quality.offered(scene, plan)
     worst = max(cands, key=lambda c: quality.cost(c, scene.video.fps))
     est = estimate.estimate(scene, RATES)

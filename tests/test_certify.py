@@ -111,7 +111,7 @@ def test_the_step_limit_refuses_up_front_what_would_blow_up(tmp_path, case):
 
 def limit_of(scene) -> float:
     from render.physics.integrators import step_limit
-    plan = registry.get(scene.system)(scene, allocate=False)
+    plan = registry.get(scene.system)(scene)
     q0, v0 = plan.initial_state()
     return step_limit(scene, plan.omega_max(q0, v0), plan.energy_limit(q0, v0, scene.integrator.method))
 

@@ -185,7 +185,7 @@ def test_maps_render_mp4_gif_and_png_byte_identical_at_1_and_2_threads(tmp_path,
     assert iio.imread(d / f"{name}.png").tobytes() == a[-1].tobytes()  # the still is the last frame, lossless
     assert (d / f"{name}.png").read_bytes() == (tmp_path / "2" / name / f"{name}.png").read_bytes()
     assert iio.imread(d / f"{name}.mp4").shape == (20, 144, 256, 3)
-    assert set(meta["outputs"]) == {f"{name}.{x}" for x in ("mp4", "gif", "png")}
+    assert set(meta["outputs"]) == {f"{name}.{x}" for x in ("mp4", "gif", "png", "npz")}
     assert not list(d.glob(".*")), "temporary files left behind"
     m = json.loads((d / "metadata.json").read_text())["map"]
     assert m["colouring"] == scene.fractal and m["pixels"] == m["plot"]["width"] * m["plot"]["height"]

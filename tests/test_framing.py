@@ -40,7 +40,7 @@ def test_soft_springs_never_leave_the_frame(stiffness):
 def test_the_energy_bound_is_tight_for_stiff_springs_and_rigid_chains_use_their_length():
     def reach(name, *sets):
         scene = load(name, list(sets))
-        return registry.get(scene.system)(scene, allocate=False).reach()
+        return registry.get(scene.system)(scene).reach()
 
     assert 2.0 < reach("elastic_fan") < 2.0 * 1.2  # the default stiffness barely stretches
     assert reach("elastic_fan", "pendulums.stiffness=50") > 2 * reach("elastic_fan", "pendulums.stiffness=1e5") > 4

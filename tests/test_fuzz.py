@@ -124,7 +124,7 @@ class Placeholder:
 
 
 def dry_render(scene, out_root, arch="cpu", progress=False, threads=None, frame_hook=None):
-    sim = registry.get(scene.system)(scene)  # everything a render does before its first kernel
+    sim = registry.kernels(scene.system)(scene)  # everything a render does before its first kernel
     d = scene.video.duration  # (the certificate's runs are kernels too: a perfect one stands in)
     return {"preset": {"name": scene.name}, "frames": scene.frames, "width": scene.video.width,
             "height": scene.video.height, "fps": scene.video.fps, "duration": d, "energy": None,
@@ -137,7 +137,7 @@ def dry_render(scene, out_root, arch="cpu", progress=False, threads=None, frame_
 
 
 def dry_simulate(scene, out_file, arch="cpu", progress=False):
-    registry.get(scene.system)(scene)
+    registry.kernels(scene.system)(scene)
     return {"frames": scene.frames, "line": "faithful (a stand-in)"}
 
 

@@ -1,6 +1,7 @@
 """The GIF drawn at its own size and rate (render/video/gif.py): its clock reads back, its rainbow stays a rainbow,
 its frames are the small canvas's, the pipe never carries a frame larger than gif_width, and the bytes do
 not depend on the thread count."""
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -129,6 +130,45 @@ def test_the_gif_frames_are_the_gif_canvas_frames(rigid):
     assert all(s.shape == (h, w, 3) for s in small.values())
     # the pipe: only frames of the GIF's size, one per GIF frame, then the end
     assert piped[-1] is None and set(piped[:-1]) == {(h, w, 3)} and len(piped) - 1 == len(shown)
+
+
+@pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000"])  # max compositing, and glow's hairlines
+def test_skipped_frames_leave_the_path_that_stamping_every_frame_leaves(name):
+    """The GIF's canvas keeps where the last bob was at each video frame it skips and stamps the path through
+    those points with the next frame it draws: the same bytes as a canvas that stamps its trail at every video
+    frame (what a trail is: the curve the bob drew), at one launch per skipped frame, not two."""
+    scene = scene_of(name, "video.fps=60", "video.duration=1.0")  # 60 -> 20 fps: two frames skipped in a row
+    src = pipeline.Source(scene)
+    frames = gif.Frames(src, scene.video, {"draw": 0.0})
+    assert gif.gap(frames.repeats) == 2
+    w, h = gif.size(scene.video)
+    ref = gif._Canvas(src, w, h, gif.rate(scene.video), 0).canvas  # follows nothing: stamped below, every frame
+    launches = []
+    mine = frames.own.canvas
+    real = mine.launch
+    mine.launch = lambda kernel, *a: (launches.append(kernel), real(kernel, *a))[1]
+    drawn = 0
+    for f in range(src.frames):
+        src.next_frame()
+        before = len(launches)
+        got = frames.frame(f, None)
+        if got is None:
+            assert len(launches) - before <= 1
+            if ref.frame_no:
+                ref.launch("bob_pixels")
+                ref.launch("stamp_trails", 0, 0)
+            continue
+        want = ref.draw(None, f / scene.video.fps)
+        assert got.tobytes() == want.tobytes(), f"video frame {f}"
+        drawn += 1
+    assert drawn == sum(map(bool, frames.repeats)) == 20 and "trail_path_pixels" in launches
+
+
+def test_gap_is_the_longest_run_of_skipped_frames():
+    assert gif.gap([1, 0, 0, 1, 0, 1]) == 2 and gif.gap([1, 1]) == 0 and gif.gap([0, 0, 0]) == 3
+    v = load("rigid_chaos").video
+    for fps, gap in ((60, 2), (30, 1), (20, 0), (50, 2)):
+        assert gif.gap(gif.repeats(dataclasses.replace(v, fps=fps), 5 * fps)) == gap, fps
 
 
 def test_the_gif_is_drawn_not_shrunk(rigid, tmp_path):

@@ -177,5 +177,5 @@ def test_every_quality_level_is_stable_on_every_preset():
             sc = load(str(path), quality=level)
             small = {"video": {"width": 16, "height": 16}} if sc.pendulums.layout == "grid" else {}
             sc = sc.replace(**small) if small else sc.replace(pendulums={"count": 1})  # a grid counts its pixels
-            sim = registry.get(sc.system)(sc, allocate=False)  # raises SceneError beyond the method's stability limit
+            sim = registry.get(sc.system)(sc)  # raises SceneError beyond the method's stability limit
             assert sim.h <= (sc.integrator.dt if sc.integrator.dt != "auto" else 1e-3) + 1e-15

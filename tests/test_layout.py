@@ -171,7 +171,7 @@ def test_coinciding_ticks_stay_apart_and_the_time_axis_is_labelled():
 
     runtime.init("cpu", "f64")
     scene = load("elastic_fan")
-    sim = registry.get(scene.system)(scene)
+    sim = registry.kernels(scene.system)(scene)
     info = hud.Info("caption", "verlet", 1e-3, "f64", faithful_until_s=2.28, median_until_s=2.39)
     h = hud.Hud(scene, sim, info, 1280, 720)
     a, r = h.ticks

@@ -1,5 +1,5 @@
 """The package's structure: layers that import only downwards, systems from the registry (nothing else names one),
-and imports that form no cycle."""
+their declarations apart from their Taichi side, and imports that form no cycle."""
 import ast
 from pathlib import Path
 
@@ -7,10 +7,13 @@ import pytest
 
 from render.commands import cli
 from render.physics import integrators, reference, registry
+from render.physics.plan import Plan
+from render.physics.system import System
 from render.config.scene import EFFECTS, LINK_EFFECTS, load
 
 PKG = Path(__file__).resolve().parent.parent / "render"
 SYSTEM_DIR = PKG / "physics" / "systems"
+KERNEL_DIR = PKG / "physics" / "kernels"
 
 # render/'s layers, lowest first (docs/architecture.md): a module may import its own layer and those before it.
 # The faces (render/__init__.py, __main__.py) stand above them all; errors.py below them all.
@@ -47,8 +50,10 @@ def import_graph() -> dict[str, set[str]]:
     files = sorted(PKG.rglob("*.py"))
     known = {module_name(f) for f in files}
     graph = {module_name(f): imported_modules(f, known) - {module_name(f)} for f in files}
-    # The registry imports every system module by discovery (importlib), which ast cannot see.
-    graph["render.physics.registry"] |= {module_name(f) for f in SYSTEM_DIR.glob("*.py") if f.name != "__init__.py"}
+    # The registry imports every system module by discovery and its Taichi side by name (importlib), which ast
+    # cannot see.
+    graph["render.physics.registry"] |= {module_name(f) for folder in (SYSTEM_DIR, KERNEL_DIR)
+                                         for f in folder.glob("*.py") if f.name != "__init__.py"}
     # The command line imports the module of the command given (importlib, so `--help` stays light).
     graph["render.commands.cli"] |= {f"render.commands.{module}" for module, _ in cli.COMMANDS.values()}
     return graph
@@ -111,7 +116,7 @@ def test_no_module_outside_the_systems_and_the_registry_names_a_system():
     names = set(registry.names())
     offenders = []
     for path in sorted(PKG.rglob("*.py")):
-        if path.parent == SYSTEM_DIR or path.name == "registry.py":
+        if path.parent in (SYSTEM_DIR, KERNEL_DIR) or path.name == "registry.py":
             continue
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Constant) and node.value in names:
@@ -153,9 +158,21 @@ def test_every_system_declares_its_contract(name):
     assert {f"theta{k}" for k in range(1, len(cls.LINKS) + 1)} <= set(cls.preset_keys())
 
 
+@pytest.mark.parametrize("name", registry.names())
+def test_every_system_has_its_taichi_side_apart_from_its_declaration(name):
+    """The registry's class is the declaration and plan (no Taichi); the Taichi class, in the module of the same
+    name in physics/kernels/, is that plan with the shared kernels and the system's own Taichi functions."""
+    plan, kernels = registry.get(name), registry.kernels(name)
+    assert issubclass(plan, Plan) and not issubclass(plan, System)
+    assert issubclass(kernels, plan) and issubclass(kernels, System) and kernels.SYSTEM == name
+    assert kernels.__module__ == plan.__module__.replace(".systems.", ".kernels.")
+    own = {k for k, v in vars(kernels).items() if callable(v)}
+    assert {"accel", "energy", "points"} <= own, own  # its physics in Taichi, not the base's placeholders
+
+
 def starts_taichi_or_builds_a_system(path: Path) -> list[str]:
-    """runtime.init(...) or ti.init(...) calls, and systems built with fields: registry.get(...)(...) without
-    allocate=False."""
+    """runtime.init(...) or ti.init(...) calls, and systems built with fields: registry.kernels(...)(...) without
+    allocate=False (registry.get(...)(...) only plans)."""
     found = []
     for node in ast.walk(ast.parse(path.read_text())):
         if not isinstance(node, ast.Call):
@@ -166,7 +183,7 @@ def starts_taichi_or_builds_a_system(path: Path) -> list[str]:
             found.append(f"{node.lineno}: {f.value.id}.init")
         planned = any(k.arg == "allocate" and isinstance(k.value, ast.Constant) and k.value.value is False
                       for k in node.keywords)
-        if isinstance(f, ast.Call) and isinstance(f.func, ast.Attribute) and f.func.attr == "get" and \
+        if isinstance(f, ast.Call) and isinstance(f.func, ast.Attribute) and f.func.attr == "kernels" and \
                 isinstance(f.func.value, ast.Name) and f.func.value.id == "registry" and not planned:
             found.append(f"{node.lineno}: a system built")
     return found

@@ -8,7 +8,7 @@ import pytest
 
 from conftest import SMALL_FPS, SMALL_H, SMALL_SECONDS, SMALL_W, out_folder, run_cli, small_scene
 from render.config.scene import list_presets, load
-from render.physics.system import DEFAULT_MAX_DRIFT
+from render.physics.integrators import DEFAULT_MAX_DRIFT
 
 
 PRESETS = [p.stem for p in list_presets()]
@@ -77,7 +77,7 @@ def test_metadata_has_the_contract_fields(rendered, name):
         # a comparison's drift is its worst variant's, a coarse method shown on purpose: the watchdog's bound
         floor = DEFAULT_MAX_DRIFT if "compare" in meta else 1e-3
         assert 0 <= meta["energy"]["max_rel_drift"] < max(floor, meta["preset"]["integrator"]["max_drift"] or 0)
-    for key in ("faithfulness", "quality"):  # certified renders (DESIGN.md, round 2)
+    for key in ("faithfulness", "quality"):  # certified renders (docs/certified-renders.md)
         assert key in meta, key
     assert not list(d.glob(".*")), "temporary files left behind"
 

@@ -31,7 +31,7 @@ def random_starts(seed=22):
 
 
 def stated_limit(scene) -> float:
-    plan = registry.get(scene.system)(scene, allocate=False)
+    plan = registry.get(scene.system)(scene)
     q0, v0 = plan.initial_state()
     return integrators.step_limit(scene, plan.omega_max(q0, v0), plan.energy_limit(q0, v0, scene.integrator.method))
 
@@ -62,7 +62,7 @@ def test_rk2_on_springs_at_095_of_its_stated_limit_runs_clean(stiffness, damping
     base = make_scene("elastic", 4, pendulums=pend, integrator={"method": "rk2"},
                       video={"fps": 5, "duration": DURATION}, effects=["energy"])
     limit = stated_limit(base)
-    plan = registry.get("elastic")(base, allocate=False)
+    plan = registry.get("elastic")(base)
     assert limit < integrators.stability_limit(base, plan.omega_max(*plan.initial_state()))  # the energy binds
     assert plan.energy_limit(*plan.initial_state(), "symplectic_euler") == math.inf
     sim = run(base.replace(integrator={"dt": 0.95 * limit}))

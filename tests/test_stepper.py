@@ -6,7 +6,7 @@ import taichi as ti
 
 from conftest import make_scene
 from render.errors import SimulationError
-from render.physics import reference, runtime
+from render.physics import reference, runtime, stepper
 from render.physics.stepper import Run
 from render.trust import certify
 
@@ -71,3 +71,31 @@ def test_where_the_watchdog_is_off_a_blow_up_is_a_result():
     scene = make_scene("elastic", 8, **BLOWS_UP)
     q, _ = certify.trajectory(scene, np.array([2, 5]), "cpu")
     assert q.shape[0] == scene.frames and np.isfinite(q[0]).all() and not np.isfinite(q[-1]).all()
+
+
+def test_a_free_system_with_the_same_constants_is_reused_and_gives_the_same_states():
+    """stepper.build: a second run of the same constants at another step reuses the first's compiled system once
+    nothing holds it, and steps exactly as a new one would; a system still held is never shared."""
+    import gc
+    scene = make_scene("rigid", 5, pendulums=PEND, video={"fps": 10, "duration": 0.5}, integrator={"dt": 2e-3})
+    fine = scene.replace(integrator={"dt": 1e-3})
+
+    def last(run):
+        for _ in run.frames():
+            pass
+        return run.sim.q.to_numpy().copy(), dict(runtime.allocated)
+
+    first = Run(scene)
+    first_id, (q_coarse, fields) = id(first.sim), last(first)
+    held = Run(fine)
+    assert id(held.sim) != first_id  # `first` still holds its system
+    q_fresh, _ = last(held)
+    del first, held
+    gc.collect()
+    again = Run(fine)
+    assert id(again.sim) in {first_id} | {id(b[2]) for b in stepper._built}  # a built one, not a new one
+    q_again, fields_again = last(again)
+    assert np.array_equal(q_again, q_fresh) and not np.array_equal(q_again, q_coarse)
+    assert fields_again == fields  # the run reports the fields it holds, as a new one does
+    other = Run(scene.replace(pendulums={"masses": [1.0, 2.0]}))  # another constant: its own kernels
+    assert other.sim is not again.sim

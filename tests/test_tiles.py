@@ -1,9 +1,12 @@
-"""A map in tiles over Dask (`render MAP --scheduler ADDR`, `--tiles N`): the same bytes as the local render,
-a worker killed mid-render, and the refusals.
+"""A map in tiles over Dask (`render MAP --scheduler ADDR`, `--tiles N`): the same bytes as the local render
+(MP4, GIF, PNG and NAME.npz), a worker killed mid-render, the FTLE map's band edges (its bands run in this
+process), and the refusals.
 
-One LocalCluster of two worker processes on loopback serves the module. The map is small (256x144, so its
-axes, legend and clock are drawn around a 77x77 plot, 1.5 s) and its tolerance tight enough that some pixels
-are past their faithful time: the bands must draw the hatch of the whole plot, not their own.
+One LocalCluster of two worker processes on loopback serves the module, and one local render is the
+reference. The map is small (256x144, so its axes, legend and clock are drawn around a 77x77 plot, 1 s at
+10 fps), supersampled (4 samples: a band's points are its pixels' samples, adjacent) and its tolerance tight
+enough that some pixels are past their faithful time: the bands must draw the hatch of the whole plot, not
+their own.
 """
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ import signal
 import socket
 import threading
 import time
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -23,13 +27,14 @@ import pytest
 
 distributed = pytest.importorskip("dask.distributed")
 
-from render.commands import api  # noqa: E402 - after the skip
+import render  # noqa: E402 - after the skip
+from render.commands import api  # noqa: E402
 from render.commands.cli import main  # noqa: E402
 from render.maps import tiles  # noqa: E402
 from render.physics import grid  # noqa: E402
-from render.video import pipeline  # noqa: E402
+from render.video import pipeline, tiled  # noqa: E402
 
-SETS = ["video.width=256", "video.height=144", "video.duration=1.5", "video.fps=20",
+SETS = ["video.width=256", "video.height=144", "video.duration=1", "video.fps=10", "map.samples=4",
         "integrator.tolerance=1e-5", "integrator.min_faithful=0"]
 
 
@@ -48,7 +53,7 @@ def digest_of(frames: list) -> str:
     return hashlib.sha256(b"".join(frames)).hexdigest()
 
 
-def render(sc, out: Path, **kw) -> tuple[dict, list[bytes]]:
+def render_to(sc, out: Path, **kw) -> tuple[dict, list[bytes]]:
     frames = []
     meta = pipeline.render(sc, out, frame_hook=lambda f, frame: frames.append(frame.tobytes()), **kw)
     return meta, frames
@@ -57,7 +62,7 @@ def render(sc, out: Path, **kw) -> tuple[dict, list[bytes]]:
 @pytest.fixture(scope="module")
 def local(tmp_path_factory):
     out = tmp_path_factory.mktemp("local")
-    meta, frames = render(scene(), out)
+    meta, frames = render_to(scene(), out)
     return out / meta["preset"]["name"], meta, frames
 
 
@@ -79,31 +84,65 @@ def test_bands_cover_the_plot_once():
         assert rows == list(range(h))
 
 
+def test_a_band_keeps_its_own_rows_of_what_it_integrated():
+    """Per pixel or per sample (4 a pixel), with a halo row each side: only the band's rows come back."""
+    span, rows = range(9, 21), range(10, 20)  # 12 rows integrated, 10 the band's own; 5 pixels a row
+    per_pixel = np.arange(12 * 5)
+    assert np.array_equal(tiles.inner(per_pixel, rows, span), np.arange(5, 55))
+    per_sample = np.arange(12 * 5 * 4).reshape(-1, 1).repeat(2, 1)  # (points, links), as the angles map's q
+    assert np.array_equal(tiles.inner(per_sample, rows, span), per_sample[20:220])
+
+
 def test_tiles_give_the_local_render_byte_for_byte(cluster, local, tmp_path):
     folder, meta, frames = local
     m = meta["map"]
+    assert m["samples"] == 4 and m["pixels"] == 77 * 77
     assert 0 < m["events_trusted"] < m["events"] and 0 < m["pending_trusted"] < m["pending"]  # the mask shows
     _, client = cluster
-    tiled, tiled_frames = render(scene(), tmp_path, cluster=client, bands=3)
+    got, tiled_frames = render_to(scene(), tmp_path, cluster=client, bands=2)
     assert len(tiled_frames) == len(frames) == meta["frames"]
     assert digest_of(tiled_frames) == digest_of(frames)
-    assert tiled["outputs_sha256"] == meta["outputs_sha256"]  # the MP4, the GIF and the PNG
-    assert {k: v for k, v in tiled["map"].items() if k != "tiles"} == m
-    assert tiled["map"]["tiles"]["bands"] == 3 and tiled["map"]["tiles"]["band_rows"] == [[0, 25], [25, 51], [51, 77]]
-    assert tiled["kernels"] == meta["kernels"]
+    name = meta["preset"]["name"]
+    assert set(meta["outputs_sha256"]) >= {f"{name}.mp4", f"{name}.gif", f"{name}.png", f"{name}.npz"}
+    assert got["outputs_sha256"] == meta["outputs_sha256"]  # the MP4, the GIF, the PNG and the npz
+    assert {k: v for k, v in got["map"].items() if k != "tiles"} == m
+    assert got["map"]["tiles"]["bands"] == 2 and got["map"]["tiles"]["band_rows"] == [[0, 38], [38, 77]]
+    assert got["kernels"] == meta["kernels"] and got["integrator"] == meta["integrator"]
+    here, there = render.load_map(folder), render.load_map(tmp_path / name)
+    for field in ("value", "cannot_flip", "trusted_until", "trusted", "starts"):
+        assert np.array_equal(getattr(here, field), getattr(there, field), equal_nan=True), field
+    assert here.value.shape == (77, 77, 4) and here.t == there.t > 0
 
 
-@pytest.mark.parametrize("name", ["fractal_divergence", "fractal_lyapunov"])
-def test_other_colourings_tile_the_same(cluster, tmp_path, name):
-    """Twins in one band; the FTLE map's barrier curve across band edges (its bands' halo)."""
-    _, client = cluster
-    sc = scene(name, "video.duration=0.25")
-    meta, frames = render(sc, tmp_path / "local")
-    tiled, tiled_frames = render(sc, tmp_path / "tiled", cluster=client, bands=4)
-    assert digest_of(tiled_frames) == digest_of(frames)
-    assert tiled["outputs_sha256"] == meta["outputs_sha256"]
-    if name == "fractal_lyapunov":
-        assert meta["map"]["barrier_pixels"] > 0 and tiled["map"]["barrier_pixels"] == meta["map"]["barrier_pixels"]
+def test_ftle_bands_draw_the_barrier_across_their_edges():
+    """The FTLE map's barrier curve reads each point's neighbours: its bands integrate a halo row each side.
+    Its bands run here, in this process (render_band is the task as a worker runs it), against the local map."""
+    h, w = 32, 96  # too small for axes: the plot fills the frame, and its barrier's oval is flat at the top
+    sc = api.load("fractal_lyapunov", f"video.width={w}", f"video.height={h}", "video.duration=0.2", "video.fps=10",
+                  "integrator.min_faithful=0")
+    src = pipeline.Source(sc)
+    whole = [src.next_frame().copy() for _ in range(sc.frames)]
+    inside = src.canvas.inside.reshape(h, w)  # E < B
+    # the bands meet where a pixel is on the curve only through its neighbour across the cut
+    cut = next(r for r in range(4, h - 3) if on_curve_across(inside, r) or on_curve_across(inside[::-1], h - r))
+    mine, summary = src.canvas.result(), src.canvas.summary()
+    results = [tiles.render_band(src.scene, rows, src.cert) for rows in (range(0, cut), range(cut, h))]
+    asm = tiles.Assembly(src.scene, results)
+    for f in range(sc.frames):
+        assert np.array_equal(asm.frame(f), whole[f]), f
+    theirs = asm.result()
+    for k in ("value", "claim", "cannot_flip", "until"):
+        assert np.array_equal(mine[k], theirs[k]), k
+    assert asm.summary() == summary and summary["barrier_pixels"] > 0
+
+
+def on_curve_across(inside, r) -> bool:
+    """Whether a pixel of row r - 1 is inside the barrier (E < B) with only its neighbour below, in row r,
+    outside: on the curve only by a neighbour that a band ending at row r does not hold."""
+    if not 2 <= r < len(inside):
+        return False
+    mid = inside[r - 1, 1:-1]
+    return bool((mid & ~inside[r, 1:-1] & inside[r - 2, 1:-1] & inside[r - 1, :-2] & inside[r - 1, 2:]).any())
 
 
 def test_a_worker_killed_mid_render_is_retried(cluster, local, tmp_path):
@@ -121,7 +160,7 @@ def test_a_worker_killed_mid_render_is_retried(cluster, local, tmp_path):
                     os.kill(pids[worker], signal.SIGKILL)
                     killed.append(worker)
                     return
-            time.sleep(0.02)
+            time.sleep(0.01)
 
     thread = threading.Thread(target=killer, daemon=True)
     thread.start()
@@ -154,7 +193,8 @@ def test_only_a_map_is_tiled(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unreachable_scheduler_writes_nothing(tmp_path):
+def test_an_unreachable_scheduler_writes_nothing(tmp_path, monkeypatch):
+    monkeypatch.setattr(tiled, "CONNECT_TIMEOUT", "1s")  # Client retries a refused connection until then
     with socket.socket() as sock:  # a loopback port that no one listens on
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
@@ -166,10 +206,8 @@ def test_an_unreachable_scheduler_writes_nothing(tmp_path):
 
 def test_assembly_undoes_the_deltas():
     """The bands' frames travel as XOR deltas, zlib-compressed: they come back exactly."""
-    import zlib
-
     sc = scene()
-    lay = grid.layout(sc.video.width, sc.video.height)
+    lay = grid.plot(sc)
     rng = np.random.default_rng(1)
     whole = rng.integers(0, 256, (3, lay.height, lay.width, 3), dtype=np.uint8)
     bands = tiles.bands(lay.h, 2)

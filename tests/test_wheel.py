@@ -56,7 +56,7 @@ def test_the_wheel_holds_the_package_and_every_preset(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     presets = sorted(p.name for p in (ROOT / "presets").glob("*.toml"))
     assert sorted(Path(n).name for n in names if n.startswith("render/presets/")) == presets
-    assert "render/physics/systems/rigid.py" in names and "render/commands/api.py" in names
+    assert {"render/physics/systems/rigid.py", "render/physics/kernels/rigid.py", "render/commands/api.py"} <= set(names)
     assert not any(n.startswith(("tests/", "presets/", "benchmarks/")) for n in names)
     meta = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
     assert "Requires-Python: >=3.11" in meta

@@ -1,4 +1,4 @@
-"""The Python API: `load`, `render`, `simulate` and `compare`. The CLI is a thin layer over it.
+"""The Python API: `load`, `render`, `simulate`, `compare` and `load_map`. The CLI is a thin layer over it.
 
 Every check the command line makes before any work lives here, so a notebook gets the same refusals as a
 shell: bad input raises SceneError (the CLI's exit 2) before anything is written, a failure while running
@@ -9,19 +9,22 @@ raises SimulationError or EncodeError (exit 1), the file system's errors are OSE
     result = render.render(scene, out="out")      # a RenderResult: paths, metadata, certificate
     traj = render.simulate(scene)                 # a Trajectory: t, theta/omega or pos/vel, energy
     both = render.compare("rigid_chaos", vary={"integrator.precision": ["f32", "f64"]})  # a split screen
+    pixels = render.load_map("out/fractal_flip")  # a map's NAME.npz: its pixels' flip times, mask, axes
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
 from ..config import budget, scene as scenes
-from . import comparison
+from . import batch
 from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
 from ..config.options import (check_arch, check_out_folder, check_replaceable, check_threads, check_tiles,
                               check_writable)
+from ..config.vary import VARIANTS, VARYING, vary_refusal
 from .results import RenderResult, Trajectory
 
 
@@ -148,12 +151,56 @@ def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.Pat
         values = {}
         for key, val in vary.items():
             _flatten(key, val, values)
-        scene = comparison.with_table(scene, values)
+        scene = with_table(scene, values)
     elif isinstance(vary, (list, tuple)) and all(isinstance(v, str) for v in vary):  # [] as no --vary
-        scene = comparison.with_vary(scene, list(vary))
+        scene = with_vary(scene, list(vary))
     elif vary is not None:
         raise SceneError(f"vary={type(vary).__name__}: must be a dict {{KEY: [V1, V2]}}, a string 'KEY=V1,V2' as "
                          f"--vary takes it, or a list of such strings")
     elif not scene.compare:
         raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give vary={{KEY: [V1, V2]}}")
     return render(scene, out, arch=arch, threads=threads, progress=progress)
+
+
+def with_vary(scene, items: list[str]):
+    """The scene with --vary items ("KEY=V1,V2", as `pendulum compare` and compare(vary=) take them) as its
+    [compare] table, validated as a preset's is; without any, its own table."""
+    if not items:
+        if not scene.compare:
+            raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give --vary KEY=V1,V2 "
+                             f"(e.g. --vary integrator.precision=f32,f64)")
+        return scene
+    for item in items:  # which keys may vary, before their values are parsed
+        key = item.partition("=")[0].strip()
+        batch.check_key(key, "--vary")
+        why = vary_refusal(key)
+        if why:
+            raise SceneError(f"--vary {key}: cannot vary: {why}; {VARYING}")
+    vary = {}
+    for key, vals in batch.parse_sweeps(items, "--vary"):
+        if key in vary:
+            raise SceneError(f"--vary {key}: given twice; list every value in one --vary")
+        lo, hi = VARIANTS
+        if not lo <= len(vals) <= hi:
+            raise SceneError(f"--vary {key}: {len(vals)} value(s); a comparison has {lo} to {hi} panels, one value "
+                             f"each")
+        if vary and len(vals) != len(next(iter(vary.values()))):
+            first = next(iter(vary))
+            raise SceneError(f"--vary {key}: {len(vals)} values and {first} has {len(vary[first])}: --vary lists "
+                             f"are paired, one value per panel")
+        vary[key] = [scenes.parse_override(f"{key}={raw}", "--vary")[1] for raw, _ in vals]
+    return with_table(scene, vary)
+
+
+def with_table(scene, vary: dict):
+    """The scene with [compare] vary = `vary` (dotted key -> one value per panel), validated as a preset's."""
+    raw = scene.to_dict()
+    raw["compare"] = {"vary": vary}
+    return dataclasses.replace(scenes.from_dict(raw, scene.source), overrides=scene.overrides)
+
+
+def load_map(path: str | os.PathLike):
+    """A map render's per-pixel data (a MapData, render/maps/data.py): its NAME.npz, or the render's folder
+    OUT/NAME/ that holds it."""
+    from ..maps import data
+    return data.load(path)

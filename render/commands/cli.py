@@ -88,17 +88,27 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
     return p
 
 
+def load_preset(preset: str, args):
+    """The preset under the command line's --set, --quality and --budget (api.load's, which needs no Taichi).
+    The commands load their scenes before they import the API: its renderer imports Taichi, which a preset
+    refused (exit 2) has no use for (tests/test_start.py)."""
+    from ..config.scene import load
+
+    return budgeted(load(preset, args.overrides, args.quality), args)
+
+
 def cmd_render(args) -> int:
-    from . import api
-    from ..config import budget
     from ..video.tiled import scheduler_address
 
     address = scheduler_address(args.scheduler)  # a bad one before any work
-    scenes = [budgeted(api.load(p, *args.overrides, quality=args.quality), args) for p in args.presets]  # all first
+    scenes = [load_preset(p, args) for p in args.presets]  # all first
     if args.name and len(scenes) > 1:
         raise SceneError(f"--name {args.name}: names one render's folder; give one PRESET")
     overridden = bool(args.overrides or args.quality)  # then not OUT/NAME/, which is the preset as written
     scenes = distinct([output_name(s, overridden, args.name) for s in scenes], args.out)
+    from . import api
+    from ..config import budget
+
     tiled = "--scheduler" if address else "--tiles" if args.tiles else None
     api.check_render(scenes, args.out, tiled)  # every scene's refusals before the first render
     budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
@@ -123,10 +133,10 @@ def distinct(scenes: list, out: Path) -> list:
 
 
 def cmd_simulate(args) -> int:
+    scene = load_preset(args.preset, args)
     from . import api
     from ..config import budget
 
-    scene = budgeted(api.load(args.preset, *args.overrides, quality=args.quality), args)
     api.check_npz(args.out, scene.name)
     budget.check_run([scene], args.out.parent, simulate=True)  # the estimate, when over a minute
     traj = api.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))

@@ -14,15 +14,10 @@ renders to OUT/compare/NAME__<short hash>/ unless --name names the folder, as `r
 from __future__ import annotations
 
 import argparse
-import dataclasses
-from pathlib import Path
 
-from . import batch
-from ..video import pipeline
-from ..errors import SceneError
-from ..config.options import add_render_options, budgeted, check_out_folder, output_name, progress_wanted
-from ..config.scene import from_dict, load, parse_override
-from ..config.vary import VARIANTS, VARYING, vary_refusal
+from . import api
+from ..config import budget
+from ..config.options import add_render_options, budgeted, output_name, progress_wanted
 
 EXAMPLES = """examples:
   pendulum compare rigid_chaos --vary integrator.precision=f32,f64
@@ -56,69 +51,16 @@ def add_parser(sub):
     c.set_defaults(func=run)
 
 
-def with_vary(scene, items: list[str]):
-    """The scene with --vary as its [compare] table (validated as a preset's is), or its own table."""
-    if not items:
-        if not scene.compare:
-            raise SceneError(f"{scene.source}: compare: the preset has no [compare] table; give --vary KEY=V1,V2 "
-                             f"(e.g. --vary integrator.precision=f32,f64)")
-        return scene
-    for item in items:  # which keys may vary, before their values are parsed
-        key = item.partition("=")[0].strip()
-        batch.check_key(key, "--vary")
-        why = vary_refusal(key)
-        if why:
-            raise SceneError(f"--vary {key}: cannot vary: {why}; {VARYING}")
-    vary = {}
-    for key, vals in batch.parse_sweeps(items, "--vary"):
-        if key in vary:
-            raise SceneError(f"--vary {key}: given twice; list every value in one --vary")
-        lo, hi = VARIANTS
-        if not lo <= len(vals) <= hi:
-            raise SceneError(f"--vary {key}: {len(vals)} value(s); a comparison has {lo} to {hi} panels, one value "
-                             f"each")
-        if vary and len(vals) != len(next(iter(vary.values()))):
-            first = next(iter(vary))
-            raise SceneError(f"--vary {key}: {len(vals)} values and {first} has {len(vary[first])}: --vary lists "
-                             f"are paired, one value per panel")
-        vary[key] = [parse_override(f"{key}={raw}", "--vary")[1] for raw, _ in vals]
-    return with_table(scene, vary)
-
-
-def with_table(scene, vary: dict):
-    """The scene with [compare] vary = `vary` (dotted key -> one value per panel), validated as a preset's."""
-    raw = scene.to_dict()
-    raw["compare"] = {"vary": vary}
-    return dataclasses.replace(from_dict(raw, scene.source), overrides=scene.overrides)
-
-
 def run(args) -> int:
-    from ..config import budget
-
-    given = load(args.preset, args.overrides, args.quality)
-    scene = with_vary(given, args.vary)
+    """As `pendulum render` runs (cli.cmd_render): the scene named for its folder, then the API's refusals
+    and render, so the command and render.compare refuse alike."""
+    given = api.load(args.preset, *args.overrides, quality=args.quality)
+    scene = api.with_vary(given, args.vary)
     # A --vary replacing the preset's own comparison is an override like --set: OUT/compare/NAME/ keeps the
     # comparison the preset states.
     overridden = bool(args.overrides or args.quality or (given.compare and scene.compare != given.compare))
-    scene = output_name(scene, overridden, args.name)
-    check_out_folder(scene, args.out)
-    out_dir = scene.out_dir(args.out)
-    budget.check_run([budgeted(scene, args)], args.out)  # every panel's parts, summed
-    meta = pipeline.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads)
-    print(summary(meta, out_dir))
+    scene = budgeted(output_name(scene, overridden, args.name), args)
+    api.check_render([scene], args.out)
+    budget.check_run([scene], args.out)  # the estimate, when over a minute: every panel's parts, summed
+    print(api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads).line())
     return 0
-
-
-def summary(meta: dict, out_dir: Path) -> str:
-    """The comparison's line: each variant's cost, divergence and certificate, and where it went."""
-    parts = []
-    for i, v in enumerate(meta["compare"]["variants"]):
-        if i == meta["compare"]["finest"]:
-            how = "finest"
-        else:
-            how = "never parts" if v["divergence_s"] is None else f"parts at {v['divergence_s']:.2f} s"
-        parts.append(f"{v['label'].removesuffix('  (finest)')}: {1e3 * v['cost_s_per_simulated_s']:.3g} ms/s, {how}, "
-                     f"faithful until {v['faithfulness']['faithful_until_s']:.2f} s")
-    t = meta["timings_s"]
-    return (f"{meta['preset']['name']}: {len(parts)} panels, {meta['frames']} frames {meta['width']}x{meta['height']}"
-            f"@{meta['fps']} | " + " | ".join(parts) + f" | total {t['total']:.2f}s -> {out_dir}/")

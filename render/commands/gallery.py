@@ -24,6 +24,7 @@ from typing import NamedTuple
 from urllib.parse import quote
 
 from . import confined
+from ..trust import faithful
 from ..video import poster
 from ..video.atomic import digest, write_atomic
 from ..errors import SceneError
@@ -223,26 +224,17 @@ def _variants(compare: dict, duration) -> str:
         parts = ("the one the others part from" if finest == i and not isinstance(finest, bool) else
                  "never parts from the finest" if parted is None else
                  f"parts from the finest at {parted:.2f} s" if _num(parted) != "?" else "parts from the finest at ?")
-        until = _get(v, "faithfulness", "faithful_until_s")
-        lines.append(f'<span class="variant">{_e(label)}: {parts}, faithful until {_until(until, duration)}</span>')
+        until = faithful.until(_get(v, "faithfulness", "faithful_until_s"), duration)
+        lines.append(f'<span class="variant">{_e(label)}: {parts}, faithful until {until}</span>')
     more = len(variants) - LISTED
     return "<br>".join(lines) + (f"<br>and {more} more in metadata.json" if more > 0 else "") or "none"
 
 
-def _until(t, duration) -> str:
-    """A faithful time in words: "the end" when it lasts the video, "?" when not a number."""
-    if _num(t) == "?":
-        return "?"
-    return "the end" if _num(duration) != "?" and t >= duration else f"{t:.2f} s"
-
-
 def _faithful(f, duration) -> str:
-    """The certificate in a few words: until when the first and the median pendulum are faithful."""
-    first, median, tol = (_get(f, k) for k in ("faithful_until_s", "median_until_s", "tolerance"))
-    if _num(first) == "?" or _num(median) == "?":
+    """The certificate in a few words (faithful.sentence, brief), its unit cut as every text on a card is."""
+    if not isinstance(f, dict) or "?" in (_num(f.get("faithful_until_s")), _num(f.get("median_until_s"))):
         return "no certificate"
-    return (f"until {_until(first, duration)} (median {_until(median, duration)}) at {_num(tol)} "
-            f"{_v(f, 'unit', default='')}").rstrip()
+    return faithful.sentence({**f, "unit": _v(f, "unit", default="")}, duration, brief=True)
 
 
 def _get(d, *keys):

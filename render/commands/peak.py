@@ -28,7 +28,7 @@ LANES = {"f64": 16, "f32": 32}  # 4 AVX2 registers of lanes either way (System.C
 GROUPS = 1024  # parallel items: many per core even on a large machine, so a busy core delays only its share
 B, C = 0.999, 0.001  # a -> c / (1 - b) = 1 from any start: no overflow, no subnormal, at any iteration count
 
-# Flops of one RK4 step of one rigid double pendulum (Rigid.accel, render/sincos.py, integrators.rk4), each
+# Flops of one RK4 step of one rigid double pendulum (RigidKernels.accel, render/physics/sincos.py, steps.rk4), each
 # add, subtract, multiply and divide counted once; products of the scene's constants are folded in Python
 # before Taichi sees them (m1, m2, l1, l2, g), and identical subexpressions (w1·w1·l1, w2·w2·l2, 2·sd) once,
 # as LLVM computes them; 0.5·h and h/6 are hoisted out of the step loop. Negations, selects and the |x|

@@ -209,7 +209,7 @@ _said: list = []
 
 
 def matplotlib_figure(scene):
-    """The matplotlib peer as a user would write it: numpy RK4 (render/reference.py) and rods, bobs and 1 s
+    """The matplotlib peer as a user would write it: numpy RK4 (render/physics/reference.py) and rods, bobs and 1 s
     trails as three artist collections, drawn by Agg at the scene's size. Returns (figure, frame(f)): frame f
     moves the artists to frame f (stepping the simulation one frame on from the previous f)."""
     import matplotlib
@@ -220,7 +220,7 @@ def matplotlib_figure(scene):
 
     from ..physics import reference, registry
 
-    plan = registry.get(scene.system)(scene, allocate=False)  # the step and the initial state, no Taichi
+    plan = registry.get(scene.system)(scene)  # the step and the initial state, no Taichi
     q, v = (a.T.copy() for a in reference.initial_state(scene))
     v_ = scene.video
     fig = plt.figure(figsize=(v_.width / 100, v_.height / 100), dpi=100, facecolor="black")

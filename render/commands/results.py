@@ -18,6 +18,8 @@ from urllib.parse import quote
 
 import numpy as np
 
+from ..trust import faithful
+
 EMBED_BYTES = 2_000_000  # a GIF up to this size is embedded: the notebook then shows it anywhere it is opened
 
 
@@ -47,15 +49,16 @@ class RenderResult:
         """What `pendulum render` prints for this render: size, integrator, certificate, timings."""
         meta = self.metadata
         if "compare" in meta:  # a split screen: each variant's cost, divergence and certificate
-            from .comparison import summary
-            return summary(meta, self.dir)
+            return _compare_line(meta, self.dir)
         i, t = meta["integrator"], meta["timings_s"]
         drift = meta["energy"]["max_rel_drift"] if meta["energy"] else None
         drift_s = f", energy drift {drift:.2g}" if drift is not None else ""
         q = meta["quality"]
         level = f" ({q['level']}: {'met' if q.get('met') else 'NOT met'})" if q["level"] else " (as the preset states)"
+        if "f64" in meta.get("map", {}).get("axes", {}):  # promoted: a zoom finer than f32 resolves (physics/grid.py)
+            level = (level if q["level"] else "") + " (f64: the zoom is finer than f32 resolves)"
         return (f"{meta['preset']['name']}: {meta['frames']} frames {meta['width']}x{meta['height']}@{meta['fps']} | "
-                f"{_method(i)}{level}{drift_s} | {_faithful(self.certificate, meta['duration'])} | "
+                f"{_method(i)}{level}{drift_s} | {faithful.sentence(self.certificate, meta['duration'])} | "
                 f"simulate {t['simulate']:.2f}s draw {t['draw']:.2f}s encode {t['encode']:.2f}s "
                 f"total {t['total']:.2f}s -> {self.dir}/")
 
@@ -69,7 +72,7 @@ class RenderResult:
         rows = [("frames", f"{meta['frames']} ({meta['width']}x{meta['height']} at {meta['fps']} fps, "
                            f"{meta['duration']:g} s)"),
                 ("method", _method(meta["integrator"])),
-                ("faithful", _faithful(self.certificate, meta["duration"])),
+                ("faithful", faithful.sentence(self.certificate, meta["duration"])),
                 ("wall time", f"{self.wall_s:.2f} s"),
                 ("files", files or "none")]
         return f"<div>{self.media_html()}{_table(rows)}</div>"
@@ -147,23 +150,31 @@ class Trajectory(Mapping):
                 ("frames", f"{len(t)}, t = 0 to {t[-1]:g} s" if len(t) else "0"),
                 ("arrays", ", ".join(f"{k} {'x'.join(map(str, v.shape))}" for k, v in self.arrays.items())),
                 ("method", _method(self.info["integrator"]) if "integrator" in self.info else "?"),
-                ("faithful", _faithful(self.certificate, self.scene.video.duration)
+                ("faithful", faithful.sentence(self.certificate, self.scene.video.duration)
                  if "faithfulness" in self.info else "?"),
                 ("energy drift", f"{self.energy_drift():.2g}" if "energy" in self.arrays else "?"),
                 ("file", str(self.path) if self.path else "not written (traj.save('x.npz') writes it)")]
         return _table(rows)
 
 
+def _compare_line(meta: dict, out_dir: Path) -> str:
+    """The comparison's line: each variant's cost, divergence and certificate, and where it went."""
+    parts = []
+    for i, v in enumerate(meta["compare"]["variants"]):
+        if i == meta["compare"]["finest"]:
+            how = "finest"
+        else:
+            how = "never parts" if v["divergence_s"] is None else f"parts at {v['divergence_s']:.2f} s"
+        until = faithful.until(v["faithfulness"]["faithful_until_s"], meta["duration"])
+        parts.append(f"{v['label'].removesuffix('  (finest)')}: {1e3 * v['cost_s_per_simulated_s']:.3g} ms/s, {how}, "
+                     f"faithful until {until}")
+    t = meta["timings_s"]
+    return (f"{meta['preset']['name']}: {len(parts)} panels, {meta['frames']} frames {meta['width']}x{meta['height']}"
+            f"@{meta['fps']} | " + " | ".join(parts) + f" | total {t['total']:.2f}s -> {out_dir}/")
+
+
 def _method(i: dict) -> str:
     return f"{i['method']} dt={i['dt']:.3g}s x{i['substeps']} {i['precision']}"
-
-
-def _faithful(f: dict, duration: float) -> str:
-    def until(t):
-        return "the end" if t >= duration else f"{t:.2f} s"
-
-    return (f"faithful until {until(f['faithful_until_s'])} (median {until(f['median_until_s'])}, "
-            f"{100 * f['fraction_faithful']:.0f} % through {duration:g} s) at {f['tolerance']:g} {f['unit']}")
 
 
 def _table(rows) -> str:

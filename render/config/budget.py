@@ -10,7 +10,7 @@ Three estimates, each against a limit stated as a share of what this machine has
 - memory: the state fields, the canvas and the frames a run holds at once: frames queued for ffmpeg, and
   every GIF frame, which ffmpeg keeps until the palette is known at the end; `simulate` keeps every frame's
   state until it writes the file. Limit: MEMORY_FRACTION of the machine's physical memory;
-- output: bytes written (MP4 and GIF, or the .npz). Limit: DISK_FRACTION of the free space where they go.
+- output: bytes written (MP4 and GIF and a map's NAME.npz, or simulate's .npz). Limit: DISK_FRACTION of the free space where they go.
 Counts are Python ints (64-bit and beyond, never a wrapped 32-bit counter); the substeps per frame must fit
 the advance kernel's i32, which integrators.check_substeps refuses when the System settles its step.
 
@@ -44,12 +44,13 @@ FALLBACK_MEMORY = 8 << 30  # where the physical memory cannot be read
 # GIF 0.53 bytes per pixel; the swinging presets compress 10 to 30 times better), so the estimate errs high.
 MP4_BYTES_PER_PIXEL = 0.05
 GIF_BYTES_PER_PIXEL = 1.0
+NPZ_BYTES_PER_START = 48  # a map's data, uncompressed: 16 for the start, up to 24 for the angles, the masks
 GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 until palettegen has seen all
 
 
 def check(scene, system, out: Path | None, simulate: bool = False):
     """Refuse `scene` if its memory, output or time exceed the limits; return its time estimate. `system` is
-    its System class (for the size of its state); `out` is where the output goes (a folder, or the .npz's
+    its class (registry.get: for the size of its state); `out` is where the output goes (a folder, or the .npz's
     folder; its bench/rates.json gives this machine's rates), None when nothing is written (the API's
     simulate without a file)."""
     from . import estimate as estimates  # it plans Systems, and system.py imports this module
@@ -215,6 +216,8 @@ def output(scene, system, simulate: bool) -> tuple[int, str, str]:
         sizes["gif"] = int(gif_frames(scene) * gif_pixels(scene) * GIF_BYTES_PER_PIXEL)
     if audio.heard(scene):  # the MP4's AAC track: its bit rate, with room to spare
         sizes["audio"] = int(2 * v.duration * AUDIO_KBPS * 125)
+    if scene.fractal:  # NAME.npz (render/maps/data.py): per start, its (x, y), its value and two masks
+        sizes["npz"] = scene.pendulums.count * NPZ_BYTES_PER_START
     return sum(sizes.values()), "video.duration", ", ".join(f"{k} {size(b)}" for k, b in sizes.items())
 
 

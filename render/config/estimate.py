@@ -124,7 +124,7 @@ def estimate(scene, rates: dict, source: str = "", simulate: bool = False) -> Es
 
 def physics(scene, rates: dict) -> tuple[dict, float, int]:
     """({simulate, certificate[, quality]} seconds, step, substeps per frame) of one (non-comparison) scene."""
-    plan = registry.get(scene.system)(scene, allocate=False)  # the stable step; refuses an unstable dt
+    plan = registry.get(scene.system)(scene)  # the stable step; refuses an unstable dt
     parts, (h, substeps) = {}, (plan.h, plan.substeps)
     cands = quality.offered(scene, plan) if scene.quality else []
     if cands:  # (none: quality.choose refuses the scene)

@@ -16,7 +16,7 @@ from ..physics import keys, registry
 from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from ..errors import SceneError
 from ..trust.levels import check_level
-from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
+from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_AXES, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
                        MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
@@ -55,7 +55,7 @@ SCHEMA: dict[str, object] = {
         "width": 1280, "height": 720, "fps": 60, "duration": 20.0, "formats": ["mp4", "gif"],
         "trail_seconds": 1.0, "gif_width": 352, "gif_fps": 20, "palette": "fan",
     },
-    "map": dict(MAP_DEFAULTS),  # fractal maps only
+    "map": {**MAP_DEFAULTS, **MAP_AXES},  # fractal maps only
 }
 
 
@@ -110,6 +110,11 @@ class MapSpec:
     epsilon: float
     threshold: float
     trust_stride: int
+    samples: int = 1  # sub-pixel starts per pixel
+    x: str = "theta1"  # the axes' quantities and spans (render/physics/grid.py)
+    y: str = "theta2"
+    x_range: tuple[float, float] = tuple(MAP_AXES["x_range"])
+    y_range: tuple[float, float] = tuple(MAP_AXES["y_range"])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,6 +169,11 @@ class Scene:
         d.pop("budget", None)  # the same frames under any budget: the same folder, up to date in `batch`
         if d["integrator"]["trig"] == "inline":  # the default of a key added later: scenes keep their hash
             del d["integrator"]["trig"]
+        for key, default in MAP_AXES.items():  # so are a map's default axes
+            if "map" in d and d["map"][key] == default:
+                del d["map"][key]
+        if d.get("map", {}).get("samples") == 1:
+            del d["map"]["samples"]
         blob = json.dumps(d, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 

@@ -13,6 +13,7 @@ import difflib
 import json
 import math
 import re
+from types import SimpleNamespace  # the validated [map] read as grid.py reads a MapSpec
 
 from ..physics import grid, keys, registry
 from ..errors import SceneError
@@ -30,7 +31,11 @@ MAP_DEFAULTS = {  # [map]: fractal maps only
     "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
     "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
     "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
+    "samples": 1,  # sub-pixel starts per pixel (render/physics/grid.py's sample_starts)
 }
+SAMPLES = (1, 4, 9)  # map.samples: a pixel's centre, or a regular 2 x 2 or 3 x 3 split of it
+MAP_AXES = {"x": grid.AXES[0], "y": grid.AXES[1], "x_range": list(grid.RANGE), "y_range": list(grid.RANGE)}
+AXIS_MAX = 1e4  # rad or rad/s: beyond it an angle has wrapped thousands of times and a rate needs µs steps
 # What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
 # New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
 EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov",
@@ -162,8 +167,11 @@ class Validator:
         system = self.choice(d["system"], "system", SYSTEMS)
         video = self.video(d)
         fractal = self.fractal(d, system)
-        pend = self.pendulums(d, system, video, fractal)
+        spec = self.map(d, fractal, system)
+        pend = self.pendulums(d, system, video, fractal, spec)
         integ = self.integrator(d, system)
+        if fractal is not None and grid.f64_reason(video["width"], video["height"], SimpleNamespace(**spec)):
+            integ["precision"] = "f64"  # a zoom f32 cannot resolve: grid.f64_reason, said in the map's metadata
         if integ["precision"] == "f32":
             for key in ("lengths", "masses"):
                 for i, x in enumerate(pend[key]):
@@ -185,7 +193,7 @@ class Validator:
         return {"name": name, "description": description, "system": system, "quality": quality,
                 "budget": self.budget(d),
                 "effects": effects, "pendulums": pend, "integrator": integ, "video": video,
-                "fractal": fractal, "map": self.map(d, fractal), "compare": self.compare(d, pend, video, fractal)}
+                "fractal": fractal, "map": spec, "compare": self.compare(d, pend, video, fractal)}
 
     def budget(self, d) -> float | None:
         """The run-time budget in seconds (render/config/budget.py), a number or a text such as "2h" or "90 min"."""
@@ -211,16 +219,47 @@ class Validator:
                       f"(systems with angles: {', '.join(n for n in SYSTEMS if registry.get(n).ANGLES)})")
         return val
 
-    def map(self, d, fractal) -> dict:
+    def map(self, d, fractal, system) -> dict:
         given = self.given.get("map") or {}
-        changed = [k for k, val in given.items() if val != MAP_DEFAULTS.get(k)]  # (a fan's own dict round trips)
+        defaults = {**MAP_DEFAULTS, **MAP_AXES}
+        changed = [k for k, val in given.items() if val != defaults.get(k)]  # (a fan's own dict round trips)
         if fractal is None and changed:
             self.fail(f"map.{changed[0]}", "only a fractal map (effects = [\"fractal\"]) has this key")
         eps = self.real(d, "map", "epsilon", 0.0, 1.0, lo_open=True)
         thr = self.real(d, "map", "threshold", 0.0, 1e3, lo_open=True)
         if fractal == "divergence" and thr <= eps:
             self.fail("map.threshold", f"must exceed map.epsilon ({eps:g}): a pair starts that far apart")
-        return {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096)}
+        out = {"epsilon": eps, "threshold": thr, "trust_stride": self.integer(d, "map", "trust_stride", 1, 4096),
+               "samples": self.samples(d)}
+        return {**out, **self.axes(d, system)}
+
+    def samples(self, d) -> int:
+        val = d["map"]["samples"]
+        if isinstance(val, bool) or not isinstance(val, int) or val not in SAMPLES:
+            self.fail("map.samples", f"must be 1, 4 or 9 (a pixel's centre, or a 2 x 2 or 3 x 3 split of it), "
+                      f"got {clip(repr(val))}")
+        return val
+
+    def axes(self, d, system) -> dict:
+        """[map] x, y (quantities, grid.quantities) and x_range, y_range ([lo, hi], lo < hi)."""
+        offered = grid.quantities(len(registry.get(system).LINKS))
+        out = {}
+        for axis in ("x", "y"):
+            val, name = d["map"][axis], f"map.{axis}"
+            if val in grid.RATIOS:
+                self.fail(name, f"{val!r} ({grid.RATIOS[val]}) would need a mass or length per pixel, and the "
+                          f"systems' kernels take one per scene; choose from {', '.join(offered)}")
+            out[axis] = self.choice(val, name, offered)
+            lo, hi = self.reals(d, "map", f"{axis}_range", 2, -AXIS_MAX, AXIS_MAX)
+            if not lo < hi:
+                self.fail(f"map.{axis}_range", f"must be [lo, hi] with lo < hi, got [{lo:g}, {hi:g}]")
+            if (hi - lo) < 1e-12 * max(abs(lo), abs(hi), 1.0):
+                self.fail(f"map.{axis}_range", f"[{lo:.17g}, {hi:.17g}] is narrower than f64 resolves pixel steps "
+                          f"in (1e-12 of the values)")
+            out[f"{axis}_range"] = (lo, hi)
+        if out["x"] == out["y"]:
+            self.fail("map.y", f"is map.x's quantity too ({out['x']!r}): a map's axes are two different quantities")
+        return out
 
     def video(self, d) -> dict:
         w = self.integer(d, "video", "width", 16, 7680)
@@ -244,17 +283,22 @@ class Validator:
         return {"width": w, "height": h, "fps": fps, "duration": dur, "formats": formats, "trail_seconds": trail,
                 "gif_width": gw, "gif_fps": gfps, "palette": palette}
 
-    def pendulums(self, d, system, video, fractal) -> dict:
+    def pendulums(self, d, system, video, fractal, spec) -> dict:
         layout = self.choice(d["pendulums"]["layout"], "pendulums.layout", LAYOUTS)
         if layout == "grid":
-            want = grid.pendulums(video["width"], video["height"], fractal)
+            want = grid.pendulums(video["width"], video["height"], fractal, SimpleNamespace(**spec))
             if d["pendulums"]["count"] is None:
                 d["pendulums"]["count"] = want
-            lay = grid.layout(video["width"], video["height"])
+            lay = grid.layout(video["width"], video["height"], SimpleNamespace(**spec))
+            samples = spec["samples"]
+            each = f"{samples} sub-pixel starts" if samples > 1 else "one pendulum"
             if d["pendulums"]["count"] != want:
-                self.fail("pendulums.count", f"a grid has one pendulum per pixel of its {lay.w}x{lay.h} plot"
-                          f"{' and a twin for each' if want != lay.pixels else ''} in a {video['width']}x"
+                self.fail("pendulums.count", f"a grid has {each} per pixel of its {lay.w}x{lay.h} plot"
+                          f"{' and a twin for each' if fractal == 'divergence' else ''} in a {video['width']}x"
                           f"{video['height']} frame: {want} (leave it out), got {d['pendulums']['count']!r}")
+            if samples > 1 and want > MAX_PENDULUMS:
+                self.fail("map.samples", f"{each} per pixel of a {lay.w}x{lay.h} plot make {want} pendulums, more "
+                          f"than {MAX_PENDULUMS}; use fewer samples or a smaller video")
         elif d["pendulums"]["count"] is None:
             self.fail("pendulums.count", "missing (this key is required)")
         count = self.integer(d, "pendulums", "count", 1, MAX_MAP_PENDULUMS if layout == "grid" else MAX_PENDULUMS)

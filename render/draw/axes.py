@@ -1,5 +1,6 @@
 """What a map's frame shows around its plot, and where: a title row, axes with ticks and labels (θ in units of
-π), a colour bar with its unit and a legend. Plain Python: it lays out, render/maps/fractal.py draws (the text
+π where the range is a simple multiple of π, else decimals with as many digits as the tick step needs, with
+the unit), a colour bar with its unit and a legend. Plain Python: it lays out, render/maps/fractal.py draws (the text
 with the bundled font, the bars and swatches with the same colour functions as the plot).
 
 Everything here is static for a render, so the map draws it once into a background that each frame copies;
@@ -39,6 +40,98 @@ def pi_label(v: float) -> str:
             num, den = num // d, den // d
     s = ("" if num == 1 else str(num)) + "π" + ("" if den == 1 else f"/{den}")
     return ("−" if k < 0 else "") + s
+
+
+def symbol(quantity: str) -> str:
+    """theta2 -> θ₂, omega1 -> ω₁."""
+    sub = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+    name, k = ("θ", quantity[5:]) if quantity.startswith("theta") else ("ω", quantity[5:])
+    return name + k.translate(sub)
+
+
+@dataclasses.dataclass(frozen=True)
+class Tick:
+    value: float
+    at: int  # where its mark goes: pixels from the axis's low end (0 .. n − 1), the boundary nearest the value
+    label: str | None  # None: a mark without a label (no room)
+
+
+def axis_ticks(quantity: str, lo: float, hi: float, n: int, spacing) -> list[Tick]:
+    """The ticks of an axis of n pixels over [lo, hi]. spacing(label) is the least distance in pixels from one
+    labelled tick to the next that keeps their labels apart.
+
+    In units of π (grid.pi_units): the ends and quarters, the odd quarters labelled where they fit. Otherwise
+    multiples of a 1-2-5 step, the finest that keeps its labels apart (but at most about ten ticks, so the
+    labels never need more digits than grid.label_chars made room for), each with the step's decimals; where
+    no step's labels fit, the coarsest step with two ticks or more, every k-th labelled."""
+    def at(v):
+        return min(round(n * (v - lo) / (hi - lo)), n - 1)
+
+    if quantity.startswith("theta") and grid.pi_units(lo, hi):
+        out = []
+        for k in range(5):
+            v = lo + k * (hi - lo) / 4
+            out.append(Tick(v, min(round(n * k / 4), n - 1),
+                            pi_label(v) if k % 2 == 0 or n // 4 >= spacing(pi_label(v)) else None))
+        return out
+    span = hi - lo
+    e = math.floor(math.log10(span / 10))
+    fallback, single = None, []
+    for step in (m * 10.0 ** k for k in range(e, e + 3) for m in (1, 2, 5)):
+        if step < span / 10 * (1 - 1e-9):
+            continue
+        decimals = max(0, -math.floor(math.log10(step) + 1e-9))
+        ks = range(math.ceil(lo / step - 1e-6), math.floor(hi / step + 1e-6) + 1)  # ends on a tick count
+        ticks = [(k * step, decimal(k * step, decimals)) for k in ks]
+        gap = n * step / span
+        need = max(spacing(label) for _, label in ticks) if ticks else 0
+        if len(ticks) >= 2 and gap >= need:
+            return [Tick(v, at(v), label) for v, label in ticks]
+        single = single or [Tick(v, at(v), label) for v, label in ticks]
+        if len(ticks) >= 2:  # if none fits: the coarsest with two ticks or more, every k-th labelled
+            every = math.ceil(need / gap - 1e-9)
+            fallback = [Tick(v, at(v), label if i % every == 0 else None) for i, (v, label) in enumerate(ticks)]
+    return fallback or single
+
+
+def x_ticks(lay: grid.Layout, quantity: str, lo: float, hi: float) -> list[Tick]:
+    """The x axis's ticks: labels side by side need 6 characters (π units: "−π/2" and a space) or their length
+    and two."""
+    cw, _ = lay.cell()
+    ticks, end = axis_ticks(quantity, lo, hi, lay.w, lambda s: max(6, len(s) + 2) * cw), -math.inf
+    for i, t in enumerate(ticks):  # a label shifted clear of the legend may meet the one before: it goes
+        if t.label:
+            x = x_label_at(lay, t)
+            if x - len(t.label) * cw / 2 < end + cw:
+                ticks[i] = dataclasses.replace(t, label=None)
+            else:
+                end = x + len(t.label) * cw / 2
+    return ticks
+
+
+def y_ticks(lay: grid.Layout, quantity: str, lo: float, hi: float) -> list[Tick]:
+    """The y axis's ticks: labels one above the other need two rows."""
+    _, ch = lay.cell()
+    return axis_ticks(quantity, lo, hi, lay.h, lambda s: 2 * ch)
+
+
+def x_label_at(lay: grid.Layout, t: Tick) -> int:
+    """Where an x tick's label is centred: on its mark, but clear of the legend's column (long decimals at the
+    right end shift left)."""
+    cw, _ = lay.cell()
+    return min(lay.x0 + t.at, lay.x0 + lay.w + 3 * lay.pad - len(t.label) * cw // 2)
+
+
+def decimal(v: float, decimals: int) -> str:
+    text = f"{v:.{decimals}f}"
+    return ("0" if float(text) == 0 else text).replace("-", "−")
+
+
+def axis_label(quantity: str, lo: float, hi: float) -> tuple[str, str | None]:
+    """The axis's name and unit: ("θ₁", None) in units of π, else ("ω₁", "rad/s")."""
+    if quantity.startswith("theta") and grid.pi_units(lo, hi):
+        return symbol(quantity), None
+    return symbol(quantity), grid.unit(quantity)
 
 
 def time_ticks(lo: float, hi: float, room: int) -> list[float]:
@@ -87,20 +180,27 @@ def decorate(scene, lay: grid.Layout, times: tuple[float, float], run: str) -> D
     # the plot's border, just outside it
     d.rects += [(x0 - 1, y0 - 1, w + 2, 1, FRAME), (x0 - 1, y0 + h, w + 2, 1, FRAME),
                 (x0 - 1, y0 - 1, 1, h + 2, FRAME), (x0 + w, y0 - 1, 1, h + 2, FRAME)]
-    lo, hi = grid.RANGE
     tick = max(1, lay.height // 360)
-    for k in range(5):  # −π, −π/2, 0, π/2, π at pixel boundaries
-        v = lo + k * (hi - lo) / 4
-        x = x0 + min(round(w * k / 4), w - 1)
-        y = y0 + h - 1 - min(round(h * k / 4), h - 1)
-        d.rects.append((x, y0 + h + 1, tick, pad, FRAME))
+    (xq, *xr), (yq, *yr) = grid.axes_of(scene.map)
+    for t in x_ticks(lay, xq, *xr):
+        d.rects.append((x0 + t.at, y0 + h + 1, tick, pad, FRAME))
+        if t.label:
+            d.texts.append((t.label, x_label_at(lay, t), y0 + h + 2 * pad, {**small, "ha": "center"}))
+    for t in y_ticks(lay, yq, *yr):
+        y = y0 + h - 1 - t.at
         d.rects.append((x0 - 1 - pad, y, pad, tick, FRAME))
-        if k % 2 == 0 or w // 4 >= 6 * cw:  # the half-π labels where they fit side by side
-            d.texts.append((pi_label(v), x, y0 + h + 2 * pad, {**small, "ha": "center"}))
-        if k % 2 == 0 or h // 4 >= 2 * ch:
-            d.texts.append((pi_label(v), x0 - 2 * pad, y, {**small, "ha": "right", "va": "middle"}))
-    d.texts.append(("θ₁", x0 + w // 2, y0 + h + 3 * pad + ch, {**small, "ha": "center"}))
-    d.texts.append(("θ₂", x0 - 3 * pad - 4 * cw, y0 + h // 2, {**small, "ha": "right", "va": "middle"}))
+        if t.label:
+            d.texts.append((t.label, x0 - 2 * pad, y, {**small, "ha": "right", "va": "middle"}))
+    name, unit = axis_label(xq, *xr)
+    d.texts.append((name + (f" [{unit}]" if unit else ""), x0 + w // 2, y0 + h + 3 * pad + ch,
+                    {**small, "ha": "center"}))
+    name, unit = axis_label(yq, *yr)
+    right = x0 - 3 * pad - max(4, grid.label_chars(yq, *yr)) * cw  # left of the widest tick label
+    if unit:  # the name over its unit
+        d.texts.append((name, right, y0 + h // 2 - pad // 2, {**small, "ha": "right", "va": "bottom"}))
+        d.texts.append((unit, right, y0 + h // 2 + pad // 2, {**small, "ha": "right", "va": "top"}))
+    else:
+        d.texts.append((name, right, y0 + h // 2, {**small, "ha": "right", "va": "middle"}))
     legend(d, scene, lay, times, x0 + w + 4 * pad)
     return d
 

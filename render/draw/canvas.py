@@ -56,16 +56,19 @@ class Canvas(runtime.Launcher):
         self.trails = scene.has("trails")
         self.decay = TRAIL_FLOOR ** (1.0 / (v.fps * v.trail_seconds))
         self.rainbow, self.glowing = v.palette == "rainbow", scene.has("glow")
-        self.glow, self.trail_light, light, block = None, 1.0, ti.f32, None  # layers: colour, row by row
-        if self.glowing:  # fixed-point light (render/draw/glow.py), stored tile by tile: thousands of lines in every
-            from . import glow  # direction touch it all over, and a steep line would miss the cache at every pixel
+        # The layers (colour, or under glow fixed-point light: render/draw/glow.py) are stored tile by tile: the
+        # frame pass reads them a tile at a time, and a steep line walks down a column. Row by row, each of a tile's
+        # rows was another page (15 kB apart at 720p): rigid_chaos's frame pass took 1.25x, its rods 1.3x as long.
+        self.glow, self.trail_light, light = None, 1.0, ti.f32
+        if self.glowing:
+            from . import glow
             self.glow, self.gain, self.trail_light = glow.Glow(self.decay), glow.gain(self.n), glow.TRAIL
-            light, block = ti.i32, TILE
+            light = ti.i32
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
         self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
-        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, block)
+        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, TILE)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
         self.section, area = None, self.w  # the pendulums' width of the frame: all of it, or left of the section
         if scene.has("poincare"):
@@ -97,11 +100,34 @@ class Canvas(runtime.Launcher):
         self.tip = len(self.links) - 1
         self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
-            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, block)
+            self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, TILE)
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
+        self.path, self.follows, self.skipped = None, False, 0  # see follow()
         self.fps = v.fps
         self.frame_no = 0
+
+    def follow(self, gap: int):
+        """For a canvas that draws only some of the frames (the GIF's, render/video/gif.py): skip() on each frame
+        it leaves out (at most `gap` in a row) keeps where the last bob is, and the next draw() stamps the path
+        through those points into the trails in the same launch, so a trail is the curve the bob drew, not
+        chords between drawn frames. Call before the first frame."""
+        if self.trails and gap:
+            self.path = runtime.field("canvas.trail_path_px", ti.f32, (gap, self.n), 2)
+            self.follows = True
+
+    @property
+    def tracing(self) -> bool:
+        """Whether skip() keeps anything now: a trail, follow()ed, after the first frame (no path before it)."""
+        return self.follows and self.frame_no > 0
+
+    def skip(self):
+        """A frame this canvas does not draw (see follow())."""
+        if self.tracing:
+            if self.skipped == self.path.shape[0]:
+                raise ValueError(f"more than {self.skipped} frames skipped in a row: follow() was told fewer")
+            self.launch("trail_path_pixels", self.skipped)
+            self.skipped += 1
 
     def restart(self):
         """Back to the first frame: no trail yet."""
@@ -111,6 +137,7 @@ class Canvas(runtime.Launcher):
         if self.trails:
             self.trail.fill(0)
             self.lit.fill(0)
+        self.skipped = 0
 
     def new_frame(self) -> np.ndarray:
         """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
@@ -126,7 +153,8 @@ class Canvas(runtime.Launcher):
             out.fill(0)  # compose_frame writes only the tiles something touched (a memset is far cheaper)
         self.launch("bob_pixels")
         if self.trails:
-            self.launch("stamp_trails", int(self.frame_no == 0))
+            self.launch("stamp_trails", int(self.frame_no == 0), self.skipped)
+            self.skipped = 0
         if self.rods:
             self.launch("draw_rods")
         if self.springs:
@@ -237,23 +265,44 @@ class Canvas(runtime.Launcher):
             a = self.pos[i, j - 1]
         return a
 
+    @ti.func
+    def pixel(self, pts, j: ti.template()):
+        """Point j of a chain (pts, world metres) in pixels, y down."""
+        return ti.Vector([self.cx + self.scale * pts[j, 0], self.cy - self.scale * pts[j, 1]], ti.f32)
+
     @ti.kernel
     def bob_pixels(self):
-        """The system's chain points, world metres to pixels (y down), at frame times only."""
-        cx, cy = self.cx, self.cy
+        """The system's chain points in pixels, at frame times only. Serial where drawing is: a few thousand
+        points are less work than waking the thread pool."""
+        ti.loop_config(serialize=self.serial)
         for i in range(self.n):
             pts = self.sim.points(self.sim.q[i])
             for j in ti.static(range(len(self.links))):
-                self.pos[i, j] = ti.Vector([cx + self.scale * pts[j, 0], cy - self.scale * pts[j, 1]], ti.f32)
+                self.pos[i, j] = self.pixel(pts, j)
 
     @ti.kernel
-    def stamp_trails(self, first: ti.i32):
-        """The outer bob's path since the last frame into the trail layer (compose_frame fades it)."""
+    def trail_path_pixels(self, slot: ti.i32):
+        """Where the last bob is at a skipped frame (follow()), in pixels."""
+        ti.loop_config(serialize=self.serial)
+        for i in range(self.n):
+            self.path[slot, i] = self.pixel(self.sim.points(self.sim.q[i]), self.tip)
+
+    @ti.kernel
+    def stamp_trails(self, first: ti.i32, skipped: ti.i32):
+        """The outer bob's path since the last frame into the trail layer (compose_frame fades it): through
+        the points of the `skipped` frames before this one (follow()), then to where it is now."""
         ti.loop_config(serialize=self.serial)
         for i in range(self.n):
             p = self.pos[i, self.tip]  # the last bob leaves the trail
             a = p if first else self.last[i]
-            self.segment(self.trail, self.lit, a, p, self.lw, self.ink(i, 0.9, 0.0) * self.trail_light, True)
+            c = self.ink(i, 0.9, 0.0) * self.trail_light
+            for s in range(skipped + 1):  # one call of segment(), which is inlined: half the code to compile
+                b = p
+                if ti.static(self.follows):
+                    if s < skipped:
+                        b = self.path[s, i]
+                self.segment(self.trail, self.lit, a, b, self.lw, c, True)
+                a = b
             self.last[i] = p
 
     @ti.kernel

@@ -31,7 +31,7 @@ frames are byte-identical whatever the thread count, later strings paint over ea
 and colour arithmetic happens in f32 (fields) or integers (uint8 arrays) whatever Taichi's default_fp.
 Cost (benchmarks/font_cost.py): one Taichi launch per call, whatever the number of strings, plus about
 1 µs of host layout per glyph; draw a frame's whole HUD with one draw_many. Another kernel can draw rows of
-layout() itself with glyph_max (a ti.func), one thread per glyph of a line, as render/hud.py does.
+layout() itself with glyph_max (a ti.func), one thread per glyph of a line, as render/draw/hud.py does.
 """
 
 import base64

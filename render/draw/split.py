@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..physics import integrators, registry, runtime
+from ..physics import integrators, registry
 from ..physics.stepper import Run
+from ..trust import faithful
 from .font import text_height
 from .hud import faces, step
 
@@ -95,12 +96,6 @@ def turned(x):
 def error_text(delta: str, x: float, angles: bool) -> str:
     """A panel's live error: `delta` (Δθ or Δx/L) and its size; an angle's wrapped, so it never reads above π."""
     return f"{delta} {amount(abs(float(turned(x))))} rad" if angles else f"{delta} {amount(x)}"
-
-
-def faithful_text(cert, duration: float) -> str:
-    """Until when a panel's own certificate holds all its certified pendulums faithful."""
-    until = cert.faithful_until_s
-    return "faithful to the end" if until >= duration else f"faithful to {until:.2f} s"
 
 
 def clock_face(height: int) -> tuple[str, int]:
@@ -188,7 +183,7 @@ class SplitScreen:
         self.scene, self.name, self.frames = scene, scene.name, scene.frames
         variants = scene.variants()
         for v in variants:  # every variant's step, refused (a pinned dt beyond its limit) before any is run
-            registry.get(v.system)(v, allocate=False)
+            registry.get(v.system)(v)
         self.runs = [record(v) for v in variants]  # pass 1, each in its own precision
         self.ref = finest(self.runs)
         v = scene.video
@@ -263,9 +258,9 @@ class SplitScreen:
             err = error_text(self.delta, self.errors[i][f], self.angles)
             lines.append((f"{err}, parted at {parted:.2f} s", COLOURS["parted"]) if parted is not None and
                          t >= parted else (err, COLOURS["close"]))
+        until = faithful.until(run["cert"].faithful_until_s, self.scene.video.duration)
         # as its clock: white while faithful, amber and red at its certificate's times (no HUD: grey)
-        return lines + [(faithful_text(run["cert"], self.scene.video.duration),
-                         COLOURS["detail"] if hud is None else hud.clock_colour(t))]
+        return lines + [(f"faithful to {until}", COLOURS["detail"] if hud is None else hud.clock_colour(t))]
 
     def labels(self, f: int) -> list[tuple]:
         """Every panel's label (and, with 3 variants, the legend in the free cell) as Font.draw_many items."""
@@ -295,36 +290,27 @@ class SplitScreen:
                 "clock amber: one not faithful", "clock red: half not faithful"]
 
     # ------------------------------------------------------------ metadata
-    def metadata(self, header: dict, timings: dict, sizes: dict, sha256: dict) -> dict:
-        """metadata.json of a comparison: a render's fields for the finest variant, and every variant's."""
+    def run_meta(self) -> dict:
+        """What metadata.json says of the simulation (pipeline.metadata), as pipeline.record says it of one
+        run: the finest variant's integrator, certificate and quality, the largest energy drift of any
+        variant, every variant's kernels."""
         ref = self.runs[self.ref]
         drifts = [run["energy"]["max_rel_drift"] for run in self.runs if run["energy"]]
         energy = {**ref["energy"], "max_rel_drift": max(drifts)} if ref["energy"] else None
-        kernels = list(dict.fromkeys(k for run in self.runs for k in run["kernels"]))
+        return {**ref, "energy": energy, "kernels": list(dict.fromkeys(k for run in self.runs for k in run["kernels"]))}
+
+    def compare_meta(self) -> dict:
+        """metadata.json's "compare": the variants, the panels, which is the finest and every variant's own."""
         return {
-            **header,
-            "integrator": ref["integrator"],  # the finest variant's, as its faithfulness and quality below
-            "effects": list(self.scene.effects),
-            "kernels": list(dict.fromkeys(kernels + list(runtime.launched))),
-            "field_bytes": sum(runtime.allocated.values()),  # the drawing pass; each variant's below
-            "fields": dict(runtime.allocated),
-            "energy": energy,
-            "faithfulness": ref["cert"].to_dict(),
-            "quality": ref["chosen"],
-            "timings_s": {k: round(val, 4) for k, val in timings.items()},
-            "outputs": sizes,
-            "outputs_sha256": sha256,
-            "compare": {
-                "vary": {key: list(values) for key, values in json.loads(json.dumps(self.scene.compare))},
-                "panels": [{"x": x, "y": y, "width": w, "height": h} for x, y, w, h in self.rects],
-                "finest": self.ref,
-                "finest_why": "the longest median faithful time of its certificate (then the first pendulum's; "
-                              "ties: f64, higher order, smaller step, the order given)",
-                "error": ("largest |Δθ| over the pendulums and angles, wrapped to [0, π], rad" if self.angles else
-                          "largest distance of a bob over the pendulums, as a fraction of the total rest length")
-                         + ", against the same pendulum of the finest variant at each frame",
-                "variants": [self.variant_meta(i) for i in range(len(self.runs))],
-            },
+            "vary": {key: list(values) for key, values in json.loads(json.dumps(self.scene.compare))},
+            "panels": [{"x": x, "y": y, "width": w, "height": h} for x, y, w, h in self.rects],
+            "finest": self.ref,
+            "finest_why": "the longest median faithful time of its certificate (then the first pendulum's; "
+                          "ties: f64, higher order, smaller step, the order given)",
+            "error": ("largest |Δθ| over the pendulums and angles, wrapped to [0, π], rad" if self.angles else
+                      "largest distance of a bob over the pendulums, as a fraction of the total rest length")
+                     + ", against the same pendulum of the finest variant at each frame",
+            "variants": [self.variant_meta(i) for i in range(len(self.runs))],
         }
 
     def variant_meta(self, i: int) -> dict:

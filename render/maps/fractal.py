@@ -1,4 +1,5 @@
-"""Fractal maps: one pendulum per pixel of a θ1 × θ2 plot (render/physics/grid.py), coloured by what it does.
+"""Fractal maps: one pendulum per pixel of a plot of two start quantities (θ1 × θ2 unless [map] x and y say
+otherwise: render/physics/grid.py), coloured by what it does.
 
 The preset key `fractal` picks the colouring:
 - **angles**: the pixel's current angles as a colour (R sin θ1, G sin θ2, B cos(θ1 + θ2));
@@ -9,7 +10,7 @@ The preset key `fractal` picks the colouring:
 
 Events are found at every substep (linearly interpolated within it), not at frame times, and a pixel whose
 event has happened is no longer integrated: its colour is settled. Pixels are advanced by the system's own
-integrator (integrators.step on the system's force, lane matrices as in System.advance): no physics here.
+integrator (steps.step on the system's force, lane matrices as in System.advance): no physics here.
 
 **Which pixels cannot flip.** With angles from the hanging position, bob i at height −Σ_{j≤i} l_j cos θ_j and
 μ_k = m_k + ... + m_n the mass at or below link k, the potential energy (zero hanging at rest) is
@@ -19,7 +20,8 @@ integrator (integrators.step on the system's force, lane matrices as in System.a
 a sum of one term per link. On the set where link k points straight up (θ_k = ±π) it is least with every
 other link hanging, where it is B_k = 2 g μ_k l_k. Energy never grows (damping only removes it) and kinetic
 energy is not negative, so a pendulum with E < B_k can never bring link k over the top, and one with
-E < B = min_k B_k flips no link at all: it is black from the first frame and never integrated. From rest,
+E < B = min_k B_k flips no link at all: it is black from the first frame and never integrated. E is each
+start's full energy (fractal_setup: kinetic too, so the claim holds with rates on the axes); from rest,
 E = V(θ(0)); for two links of equal unit masses and lengths, B = 2g and the condition is 2 cos θ1 + cos θ2
 > 1. The bound is tight: the state with link k up and the others hanging, at rest, has E = B_k exactly, so
 no smaller barrier holds (tests/test_fractal.py: a DOP853 run flips no pixel inside it, and starts just
@@ -30,6 +32,12 @@ certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_in
 pendulums, and each pixel's faithful time is the least of its lattice neighbours' (grid.faithful_map). A
 pixel whose claim reaches past that time is drawn desaturated and hatched. Pixels that cannot flip are
 trusted: energy, not the integration, settles them.
+
+**Samples and data.** With map.samples = 4 or 9 a pixel is 4 or 9 sub-pixel starts (grid.sample_starts), the
+map's *points*: each is its own pendulum (with its own twin), with its own event and its own claim against
+the pixel's faithful time, and the pixel shows their colours' mean in linear light (render/maps/supersample.py).
+With one sample, a point is its pixel. result() hands each point's value, claim and cannot-flip mask to the
+map's NAME.npz (render/maps/data.py).
 """
 
 import math
@@ -37,21 +45,12 @@ import math
 import numpy as np
 import taichi as ti
 
+from . import supersample
+from .colours import PENDING_GREY, palette, sin8, untrusted
+from .data import NEVER, PENDING  # the event field's "not happened (yet)" and "cannot happen"
 from ..draw import axes
-from ..physics import grid, integrators, runtime
+from ..physics import grid, runtime, steps
 from ..draw.font import Font
-
-PENDING = -1.0  # event field: not happened (yet)
-NEVER = -2.0  # cannot happen: below the energy barrier
-# matplotlib's plasma at 9 points, read backwards on the map (early events bright): saturated everywhere,
-# so a desaturated (untrusted) pixel stands apart, and its dark end is blue, not the black of "never"
-PALETTE = ((0.05, 0.03, 0.528), (0.3, 0.01, 0.632), (0.495, 0.012, 0.658), (0.665, 0.139, 0.586),
-           (0.798, 0.28, 0.47), (0.902, 0.425, 0.36), (0.973, 0.586, 0.252), (0.993, 0.772, 0.155),
-           (0.94, 0.975, 0.131))
-STOPS = len(PALETTE)
-PENDING_GREY = 0.24  # a flip map's pixels that may still flip
-HATCH = 5  # pixels between the diagonal lines over untrusted pixels
-
 
 def barriers(masses, lengths, g: float) -> list[float]:
     """B_k = 2 g μ_k l_k: the least energy (zero hanging at rest) with which link k can point straight up."""
@@ -61,42 +60,6 @@ def barriers(masses, lengths, g: float) -> list[float]:
 def time_scale(duration: float) -> tuple[float, float]:
     """The log colour scale's range in s: from 0.1 s (or a quarter of a short video) to the end."""
     return min(0.1, duration / 4), duration
-
-
-@ti.func
-def palette(u):
-    """u in [0, 1] to PALETTE, piecewise linear."""
-    x = ti.min(ti.max(u, 0.0), 1.0) * (STOPS - 1)
-    k = ti.min(ti.cast(ti.floor(x), ti.i32), STOPS - 2)
-    f = x - k
-    c = ti.Vector([0.0, 0.0, 0.0])
-    for j in ti.static(range(STOPS - 1)):
-        if k == j:
-            c = (1.0 - f) * ti.Vector(PALETTE[j]) + f * ti.Vector(PALETTE[j + 1])
-    return c
-
-
-@ti.func
-def sin8(x):
-    """sin(x) to within 1e-4, plenty for a colour byte and about 3x cheaper than libm's call. Reduced to
-    [-pi/2, pi/2], then the Taylor series to x^9 (error < 4e-6 there)."""
-    x = x - 2.0 * math.pi * ti.round(x * (0.5 / math.pi))
-    if x > 0.5 * math.pi:
-        x = math.pi - x
-    elif x < -0.5 * math.pi:
-        x = -math.pi - x
-    x2 = x * x
-    return x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))))
-
-
-@ti.func
-def untrusted(c, x, y):
-    """The mask: most of the colour drained, and a diagonal hatch that shows on dark pixels too."""
-    lum = 0.3 * c[0] + 0.59 * c[1] + 0.11 * c[2]
-    c = 0.75 * (lum + 0.3 * (c - lum))
-    if (x + y) % HATCH == 0:
-        c = ti.Vector([0.1, 0.1, 0.1]) if lum > 0.45 else ti.Vector([0.5, 0.5, 0.5])
-    return c
 
 
 @ti.data_oriented
@@ -116,7 +79,8 @@ class Map(runtime.Launcher):
         self.lo, self.hi = time_scale(v.duration)
         self.log_lo, self.log_span = math.log(self.lo), math.log(self.hi / self.lo)
         self.log_ratio = math.log(self.threshold / self.eps)
-        self.event = runtime.field("fractal.event", ti.f32, self.pixels)
+        self.event = runtime.field("fractal.event", ti.f32, self.points)
+        self.cannot = runtime.field("fractal.cannot_flip", ti.u8, self.points)  # E < B, whatever the colouring
         self.until = self.faithful(cert)
         self.font = Font(self.lay.font) if self.lay.font else None
         self.background = self.decorate()
@@ -125,10 +89,12 @@ class Map(runtime.Launcher):
     def place(self, rows: range | None):
         """The plot, and the band of its rows this map integrates and colours: all of them, or one tile's
         (render/maps/tiles.py: the system then holds only the band's pendulums)."""
-        self.lay = grid.layout(self.scene.video.width, self.scene.video.height)
+        self.lay = grid.plot(self.scene)
         self.rows = range(self.lay.h) if rows is None else rows
         self.w, self.h, self.r0 = self.lay.w, len(self.rows), self.rows.start
         self.pixels = self.w * self.h
+        self.samples = self.scene.map.samples  # sub-pixel starts per pixel (render/maps/supersample.py)
+        self.points = self.pixels * self.samples  # the starts: pixel p's samples are points p·samples + s
 
     def faithful(self, cert):
         """The band's per-pixel faithful times (grid.faithful_map), as a field."""
@@ -166,22 +132,47 @@ class Map(runtime.Launcher):
         return out
 
     def arrays(self) -> dict:
-        """Per pixel of the band, what summary() counts: a tile's are joined row-wise (render/maps/tiles.py)."""
-        return {"event": self.event.to_numpy(), "until": self.until.to_numpy()}
+        """The band's fields on the host at the current frame: per point `event`, `cannot` (and the angles
+        map's `q`), per pixel `until`; result() and summary() read them, a tile's are joined row-wise
+        (render/maps/tiles.py)."""
+        a = {"event": self.event.to_numpy(), "cannot": self.cannot.to_numpy(), "until": self.until.to_numpy()}
+        if self.kind == "angles":
+            a["q"] = self.sim.q.to_numpy()
+        return a
+
+    def result(self) -> dict:
+        return self.result_of(self.scene, self.arrays(), self.sim.t)
 
     def summary(self) -> dict:
         return self.summarise(self.scene, self.arrays(), self.sim.t)
 
     @staticmethod
+    def result_of(scene, a: dict, t: float) -> dict:
+        """Per point (pixels · samples, in the map's order) at time t, from arrays(), for the map's data
+        (render/maps/data.py): `value`, what the colouring measures (the event time in s, PENDING or NEVER; the
+        angles map: the links' angles, (points, links)); `claim`, how far along its trajectory the colour
+        speaks for (the trust mask compares it with the pixel's faithful time); `cannot_flip`, E < B; per pixel
+        `until`, its faithful time; and `t`."""
+        ev, t32 = a["event"], np.float32(t)
+        if scene.fractal == "angles":
+            value, claim = a["q"], np.full(len(ev), t32)
+        else:
+            value, claim = ev, np.where(ev >= 0, ev, np.where(ev == NEVER, np.float32(0), t32))
+        return {"value": value, "claim": claim, "cannot_flip": a["cannot"].astype(bool), "until": a["until"],
+                "t": t}
+
+    @staticmethod
     def summarise(scene, a: dict, t: float) -> dict:
-        """For metadata.json: the plot, the lattice, and how many pixels had their event, trusted or not, at
-        time t, from arrays() (a map's own, or its tiles' joined)."""
-        ev, until = a["event"], a["until"]
+        """For metadata.json: the plot, the lattice, and how many points (pixels, or their samples) had their
+        event, trusted or not, at time t, from arrays() (a map's own, or its tiles' joined)."""
+        ev, samples = a["event"], scene.map.samples
+        until = np.repeat(a["until"], samples)
         done, pending = ev >= 0, ev == PENDING
         claim = np.where(done, ev, np.float32(t))
-        lay, stride = grid.layout(scene.video.width, scene.video.height), scene.map.trust_stride
+        lay, stride = grid.plot(scene), scene.map.trust_stride
         return {"colouring": scene.fractal, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
-                "pixels": len(ev), "time_scale_s": list(time_scale(scene.video.duration)),
+                "axes": grid.axes_summary(scene),
+                "pixels": len(a["until"]), "samples": samples, "time_scale_s": list(time_scale(scene.video.duration)),
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
                 "cannot_flip": int((ev == NEVER).sum()), "events": int(done.sum()),
@@ -205,20 +196,23 @@ class Map(runtime.Launcher):
 
     # ------------------------------------------------------------ kernels
     @ti.func
-    def pixel(self, i):
-        """The pixel of pendulum i."""
-        p = i
+    def point(self, i):
+        """The point (a pixel's sample) of pendulum i."""
+        j = i
         if ti.static(self.twins):
-            p = i // 2
-        return p
+            j = i // 2
+        return j
 
     @ti.kernel
     def fractal_setup(self):
-        for p in range(self.pixels):
-            self.event[p] = PENDING
+        for j in range(self.points):
+            i = j * self.lanes  # the point's own pendulum, not its twin
+            below = self.sim.energy(self.sim.q[i], self.sim.v[i]) < self.barrier
+            self.cannot[j] = ti.cast(below, ti.u8)
+            self.event[j] = PENDING
             if ti.static(self.kind == "flip_time"):
-                if self.sim.energy(self.sim.q[p], self.sim.v[p]) < self.barrier:
-                    self.event[p] = NEVER
+                if below:
+                    self.event[j] = NEVER
 
     @ti.func
     def live(self, g):
@@ -226,7 +220,7 @@ class Map(runtime.Launcher):
         live = 0
         for lane in ti.static(range(self.lanes)):
             i = g * self.lanes + lane
-            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+            if i < self.sim.n and self.event[self.point(i)] == PENDING:
                 live = 1
         return live
 
@@ -255,7 +249,7 @@ class Map(runtime.Launcher):
             if self.live(g):
                 q, v = self.gather(g)
                 for s in range(substeps):
-                    q1, v1 = integrators.step(self.sim, q, v, h)
+                    q1, v1 = steps.step(self.sim, q, v, h)
                     self.events(g, q, v, q1, v1, t0 + s * h, h)
                     q, v = q1, v1
                     if not self.live(g):
@@ -267,7 +261,7 @@ class Map(runtime.Launcher):
         """Events within the step from (q, v) at t to (q1, v1) at t + h, at their interpolated times."""
         for lane in ti.static(range(0, self.lanes, 2 if self.twins else 1)):
             i = g * self.lanes + lane
-            if i < self.sim.n and self.event[self.pixel(i)] == PENDING:
+            if i < self.sim.n and self.event[self.point(i)] == PENDING:
                 frac = 2.0
                 if ti.static(self.twins):
                     d0, d1 = self.distance(q, v, lane), self.distance(q1, v1, lane)
@@ -279,7 +273,7 @@ class Map(runtime.Launcher):
                         if b > math.pi and a <= math.pi:
                             frac = ti.min(frac, (math.pi - a) / (b - a))
                 if frac <= 1.0:
-                    self.event[self.pixel(i)] = t + frac * h
+                    self.event[self.point(i)] = t + frac * h
 
     @ti.func
     def distance(self, q, v, lane: ti.template()):
@@ -306,31 +300,48 @@ class Map(runtime.Launcher):
 
     @ti.kernel
     def fractal_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
-        """Every pixel of the plot; one claims its trajectory up to min(t, its event), trusted up to its
-        faithful time."""
+        """Every pixel of the plot: its one sample's colour, or the mean of its samples' in linear light."""
         for r, c in ti.ndrange(self.h, self.w):
-            p = r * self.w + c
-            ev = self.event[p]
-            claim = t
-            col = ti.Vector([0.0, 0.0, 0.0])
-            if ti.static(self.kind == "angles"):
-                q = self.sim.q[p]
-                col = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
-            else:
-                if ev >= 0.0:
-                    col, claim = self.time_colour(ev), ev
-                elif ev == NEVER:
-                    claim = 0.0  # settled by energy, not by the integration
-                elif ti.static(self.twins):
-                    a, b = 2 * p, 2 * p + 1
-                    col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
-                                                + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
-                else:
-                    col = ti.Vector([PENDING_GREY] * 3)
-            if claim > self.until[p]:
-                col = untrusted(col, c, self.r0 + r)  # the hatch of the whole plot, whichever band this is
+            col = self.pixel_colour(r * self.w + c, t, c, self.r0 + r)  # the whole plot's hatch, in any band
             for k in ti.static(range(3)):
                 out[self.lay.y0 + self.r0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)
+
+    @ti.func
+    def pixel_colour(self, p, t, c, r):
+        """Pixel p's colour (column c, row r): its one point's, or the mean of its samples' in linear light."""
+        col = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(self.samples == 1):
+            col = self.point_colour(p, p, t, c, r)
+        else:
+            for s in ti.static(range(self.samples)):
+                col += supersample.linear(self.point_colour(p * self.samples + s, p, t, c, r))
+            col = supersample.encode(col / self.samples)
+        return col
+
+    @ti.func
+    def point_colour(self, j, p, t, c, r):
+        """Point j's colour (of pixel p, at column c and row r): it claims its trajectory up to min(t, its
+        event), trusted up to the pixel's faithful time."""
+        ev = self.event[j]
+        claim = t
+        col = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(self.kind == "angles"):
+            q = self.sim.q[j]
+            col = 0.5 + 0.5 * ti.Vector([sin8(q[0]), sin8(q[1]), sin8(q[0] + q[1] + 0.5 * math.pi)])
+        else:
+            if ev >= 0.0:
+                col, claim = self.time_colour(ev), ev
+            elif ev == NEVER:
+                claim = 0.0  # settled by energy, not by the integration
+            elif ti.static(self.twins):
+                a, b = 2 * j, 2 * j + 1
+                col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
+                                            + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
+            else:
+                col = ti.Vector([PENDING_GREY] * 3)
+        if claim > self.until[p]:
+            col = untrusted(col, c, r)
+        return col
 
     @ti.kernel
     def fractal_swatch(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), x0: ti.i32, y0: ti.i32, w: ti.i32,

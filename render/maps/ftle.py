@@ -27,7 +27,9 @@ the colour bar is in 1/s. The energy barrier (render/maps/fractal.py: a pendulum
 is the black curve E(θ1, θ2) = B: the pixels inside it next to one outside. Inside, the motion is bounded
 away from the top, and σ is still measured there, not blacked out (it is mostly small: regular motion).
 The trust mask is the other maps': every pixel claims its trajectory up to t, and is desaturated and
-hatched past the faithful time of its lattice neighbours.
+hatched past the faithful time of its lattice neighbours. With map.samples = 4 or 9 each sample (point) carries
+its own tangent vectors and σ, the barrier's curve is found on the samples' own finer grid (a sample on it is
+black), and a pixel shows its samples' colours averaged as render/maps/fractal.py's map does.
 
 **Trig.** Taichi's forward mode cannot differentiate render/physics/sincos.py's inline sin/cos, so the tangent
 kernel steps a libm twin of the system (tangent.libm_twin) and its primal is the map's state. The preset
@@ -43,8 +45,8 @@ in the vectorised loop is the way to close that gap.
 import numpy as np
 import taichi as ti
 
-from . import fractal
-from ..physics import grid, integrators, runtime
+from . import colours, fractal, supersample
+from ..physics import grid, runtime, steps
 from ..draw.font import Font
 from ..physics.tangent import check_method, libm_twin, scalarized
 
@@ -61,21 +63,21 @@ class FtleMap(fractal.Map):
     def __init__(self, scene, sim, cert, rows: range | None = None):
         check_method(scene)
         self.scene, self.sim, self.kind = scene, sim, scene.fractal
-        self.place(rows)
+        self.place(rows)  # one pendulum per point: pixel p's samples are p·samples + s
         self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
         self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
         self.twin = libm_twin(sim)
         self.k = 2 * sim.D  # tangent vectors per pixel: the state's dimension (4 for the double pendulum)
-        real, n, D = runtime.real(), self.k * self.pixels, self.k  # one kernel element per tangent vector
+        real, n, D = runtime.real(), self.k * self.points, self.k  # one kernel element per tangent vector
         # dx: a zero offset to the state, whose duals are the columns of M; out: the frame's end and its duals
         self.dx = ti.Vector.field(D, real, shape=n, needs_dual=True)
         self.out = ti.Vector.field(D, real, shape=n, needs_dual=True)
         runtime.allocated["ftle.tangents"] = 4 * n * D * (8 if real == ti.f64 else 4)  # the two and their duals
         self.loss = ti.field(real, shape=(), needs_dual=True)  # FwdMode's required (unused) loss and param:
         self.unit = ti.field(real, shape=(), needs_dual=True)  # the seeds are dx's duals, set per element
-        self.log_scale = runtime.field("ftle.log_scale", real, self.pixels)  # L
-        self.sigma = runtime.field("ftle.sigma", real, self.pixels)  # σ_t as last drawn
-        self.edge = runtime.field("ftle.barrier", ti.u8, self.pixels)
+        self.log_scale = runtime.field("ftle.log_scale", real, self.points)  # L
+        self.sigma = runtime.field("ftle.sigma", real, self.points)  # σ_t as last drawn
+        self.edge = runtime.field("ftle.barrier", ti.u8, self.points)
         self.until = self.faithful(cert)
         self.barrier = min(fractal.barriers(sim.masses, sim.lengths, sim.g))
         self.edge.from_numpy(self.barrier_curve())
@@ -84,15 +86,17 @@ class FtleMap(fractal.Map):
         self.restart()
 
     def barrier_curve(self) -> np.ndarray:
-        """Per pixel, 1 where E < B and a 4-neighbour has E ≥ B: the barrier's curve, on its inner side."""
+        """Per point, 1 where E < B and a 4-neighbour has E ≥ B: the barrier's curve, on its inner side, on the
+        samples' own grid (render/maps/supersample.py), so that supersampling draws it finer, not wider."""
         self.launch("ftle_energy")
-        inside = (self.sigma.to_numpy() < self.barrier).reshape(self.h, self.w)
+        self.inside = self.sigma.to_numpy() < self.barrier  # the cannot-flip mask, for the map's data
+        inside = supersample.fine_grid(self.inside, self.h, self.w, self.samples)
         out = np.zeros_like(inside)
         out[1:] |= ~inside[:-1]
         out[:-1] |= ~inside[1:]
         out[:, 1:] |= ~inside[:, :-1]
         out[:, :-1] |= ~inside[:, 1:]
-        return (inside & out).ravel().astype(np.uint8)
+        return supersample.coarse(inside & out, self.h, self.w, self.samples).astype(np.uint8)
 
     def restart(self):
         """M = I and L = 0 at every pixel, from the system's current (initial) state."""
@@ -111,19 +115,29 @@ class FtleMap(fractal.Map):
         return m, self.log_scale.to_numpy().astype(np.float64)
 
     def arrays(self) -> dict:
-        """Per pixel of the band, what summary() counts (fractal.Map.arrays)."""
-        return {"sigma": self.sigma.to_numpy(), "until": self.until.to_numpy(), "edge": self.edge.to_numpy()}
+        """The band's fields on the host (fractal.Map.arrays): per point `sigma`, `inside` (E < B) and `edge`,
+        per pixel `until`."""
+        return {"sigma": self.sigma.to_numpy(), "inside": self.inside.copy(), "edge": self.edge.to_numpy(),
+                "until": self.until.to_numpy()}
+
+    @staticmethod
+    def result_of(scene, a: dict, t: float) -> dict:
+        """Per point at time t, as fractal.Map.result_of(): σ_t in 1/s as last drawn; every point claims its
+        trajectory up to t."""
+        return {"value": a["sigma"], "claim": np.full(len(a["sigma"]), np.float32(t)), "cannot_flip": a["inside"],
+                "until": a["until"], "t": t}
 
     @staticmethod
     def summarise(scene, a: dict, t: float) -> dict:
-        """For metadata.json: the plot, the lattice, σ's spread and how many pixels are trusted at time t, from
-        arrays() (fractal.Map.summarise)."""
+        """For metadata.json: the plot, the lattice, σ's spread (over points) and how many pixels are trusted at
+        time t, from arrays() (fractal.Map.summarise)."""
         sig, until = a["sigma"], a["until"]
         trusted = np.float32(t) <= until
-        lay, stride = grid.layout(scene.video.width, scene.video.height), scene.map.trust_stride
+        lay, stride = grid.plot(scene), scene.map.trust_stride
         q = np.percentile(sig, [5, 50, 95]).tolist() if t > 0 else [0.0] * 3
         return {"colouring": scene.fractal, "plot": {"x": lay.x0, "y": lay.y0, "width": lay.w, "height": lay.h},
-                "pixels": len(sig), "sigma_scale_per_s": [0.0, SIGMA_MAX],
+                "axes": grid.axes_summary(scene),
+                "pixels": len(until), "samples": scene.map.samples, "sigma_scale_per_s": [0.0, SIGMA_MAX],
                 "lattice": {"stride": stride, "pixels": len(grid.lattice_axis(lay.w, stride))
                             * len(grid.lattice_axis(lay.h, stride))},
                 "t_s": t, "sigma_percentiles_5_50_95_per_s": q, "trusted": int(trusted.sum()),
@@ -133,34 +147,34 @@ class FtleMap(fractal.Map):
     @ti.kernel
     def ftle_energy(self):
         """Each pixel's energy, into sigma for now (barrier_curve reads it once)."""
-        for p in range(self.pixels):
-            self.sigma[p] = self.sim.energy(self.sim.q[p], self.sim.v[p])
+        for j in range(self.points):
+            self.sigma[j] = self.sim.energy(self.sim.q[j], self.sim.v[j])
 
     @ti.kernel
     def ftle_setup(self):
-        for e in range(self.k * self.pixels):
+        for e in range(self.k * self.points):
             self.dx[e] = ti.Vector.zero(float, self.k)
             self.dx.dual[e] = ti.Vector.unit(self.k, e % self.k, float)
-        for p in range(self.pixels):
-            self.log_scale[p], self.sigma[p] = 0.0, 0.0
+        for j in range(self.points):
+            self.log_scale[j], self.sigma[j] = 0.0, 0.0
 
     @ti.kernel
     def ftle_frame(self, sys: ti.template(), substeps: ti.i32, h: float):
-        """One frame of every pixel, four times: lane e % k with column e % k of its M as the state's dual."""
+        """One frame of every point, four times: lane e % k with column e % k of its M as the state's dual."""
         D = ti.static(self.sim.D)
-        for e in range(self.k * self.pixels):
+        for e in range(self.k * self.points):
             p, d = e // self.k, self.dx[e]
             q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
             v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
             for _ in range(substeps):
-                q, v = integrators.step(sys, q, v, h)
+                q, v = steps.step(sys, q, v, h)
             self.out[e] = ti.Vector([q[c, 0] for c in ti.static(range(D))] + [v[c, 0] for c in ti.static(range(D))])
 
     @ti.kernel
     def ftle_renormalise(self):
         """The new state (lane 0's primal), M = the frame's images over their largest entry m, L += ln m."""
         D, K = ti.static(self.sim.D, self.k)
-        for p in range(self.pixels):
+        for p in range(self.points):
             m = 0.0
             for k in ti.static(range(K)):
                 m = ti.max(m, ti.abs(self.out.dual[K * p + k]).max())
@@ -176,7 +190,7 @@ class FtleMap(fractal.Map):
 
     @ti.func
     def log_smax(self, p):
-        """ln s_max(M) of pixel p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
+        """ln s_max(M) of point p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
         K = ti.static(self.k)
         m = ti.Matrix.cols([self.dx.dual[K * p + k] for k in ti.static(range(K))])
         b = m.transpose() @ m
@@ -192,23 +206,29 @@ class FtleMap(fractal.Map):
         return 0.5 * ti.log(x.dot(b @ x) / x.norm_sqr())
 
     @ti.func
+    def point_colour(self, j, p, t, c, r):
+        """Point j's colour (of pixel p, at column c and row r), σ_t kept in sigma."""
+        s = 0.0
+        if t > 0.0:
+            s = (self.log_scale[j] + self.log_smax(j)) / t
+        self.sigma[j] = s
+        col = colours.palette(s / SIGMA_MAX)
+        if self.edge[j]:
+            col = ti.Vector([0.0, 0.0, 0.0])
+        if t > self.until[p]:
+            col = colours.untrusted(col, c, r)
+        return col
+
+    @ti.func
     def bar_colour(self, u):
         """The colour bar's colour at u in [0, 1] (bottom to top): σ = u·SIGMA_MAX."""
-        return fractal.palette(u)
+        return colours.palette(u)
 
     @ti.kernel
     def ftle_colour(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), t: ti.f32):
-        """σ_t of every pixel, on the linear scale; the barrier's curve black; past the faithful time, masked."""
+        """σ_t of every pixel, on the linear scale (of each sample, their colours averaged in linear light); the
+        barrier's curve black; past the faithful time, masked."""
         for r, c in ti.ndrange(self.h, self.w):
-            p = r * self.w + c
-            s = 0.0
-            if t > 0.0:
-                s = (self.log_scale[p] + self.log_smax(p)) / t
-            self.sigma[p] = s
-            col = fractal.palette(s / SIGMA_MAX)
-            if self.edge[p]:
-                col = ti.Vector([0.0, 0.0, 0.0])
-            if t > self.until[p]:
-                col = fractal.untrusted(col, c, self.r0 + r)
+            col = self.pixel_colour(r * self.w + c, t, c, self.r0 + r)  # the whole plot's hatch, in any band
             for k in ti.static(range(3)):
                 out[self.lay.y0 + self.r0 + r, self.lay.x0 + c, k] = ti.cast(ti.min(col[k], 1.0) * 255.0 + 0.5, ti.u8)

@@ -50,7 +50,7 @@ def render_band(scene, rows: range, cert, arch: str = "cpu", threads: int | None
 
     Returns `scene_hash` (the client checks it: a band of another scene is never put into this one), `rows`,
     `frames` (per frame the compressed XOR delta, see the module's docstring) of an array of `shape`, `arrays`
-    (the map's per-pixel arrays() of the band at the end), `t` (the clock at the end), `arch`, `kernels`,
+    (the map's arrays() of the band's own rows at the end), `t` (the clock at the end), `arch`, `kernels`,
     `fields` and `timings` (simulate, draw, compress: seconds). The watchdog's SimulationError comes back as
     `error`, not raised: it would fail the same way again, and Dask reruns what raises."""
     try:
@@ -60,7 +60,7 @@ def render_band(scene, rows: range, cert, arch: str = "cpu", threads: int | None
 
 
 def _band(scene, rows: range, cert, arch: str, threads: int | None) -> dict:
-    lay = grid.layout(scene.video.width, scene.video.height)
+    lay = grid.plot(scene)
     halo = HALO if scene.fractal == "lyapunov" else 0
     span = range(max(rows.start - halo, 0), min(rows.stop + halo, lay.h))
     per_row = scene.pendulums.count // lay.h  # pendulums are pixel after pixel, row-major (grid.grid_state)
@@ -73,16 +73,22 @@ def _band(scene, rows: range, cert, arch: str, threads: int | None) -> dict:
         for _ in run.frames(advance=canvas.advance, timings=timings):
             t = time.perf_counter()
             canvas.draw(frame)
-            part = frame.copy() if rows.start == 0 else np.ascontiguousarray(frame[y, x])
+            part = (frame if rows.start == 0 else frame[y, x]).copy()  # a copy: the next draw overwrites frame
             t1 = time.perf_counter()
             out.append(zlib.compress((part if last is None else part ^ last).tobytes(), 1))
             last = part
             timings["draw"] += t1 - t
             timings["compress"] += time.perf_counter() - t1
-        inner = slice((rows.start - span.start) * lay.w, (rows.stop - span.start) * lay.w)
         return {"scene_hash": scene.hash(), "rows": (rows.start, rows.stop), "frames": out, "shape": last.shape,
-                "arrays": {k: v[inner] for k, v in canvas.arrays().items()}, "t": run.sim.t, "arch": run.arch,
-                "kernels": list(runtime.launched), "fields": dict(runtime.allocated), "timings": timings}
+                "arrays": {k: inner(v, rows, span) for k, v in canvas.arrays().items()}, "t": run.sim.t,
+                "arch": run.arch, "kernels": list(runtime.launched), "fields": dict(runtime.allocated), "timings": timings}
+
+
+def inner(a: np.ndarray, rows: range, span: range) -> np.ndarray:
+    """The band's own `rows` of an array over the `span` it integrated (per pixel or per point, row-major: a
+    row's pixels, or their samples, are adjacent)."""
+    per_row = len(a) // len(span)
+    return a[(rows.start - span.start) * per_row:(rows.stop - span.start) * per_row]
 
 
 class Assembly:
@@ -90,7 +96,7 @@ class Assembly:
 
     def __init__(self, scene, results: list[dict]):
         self.scene, self.results = scene, results
-        lay = grid.layout(scene.video.width, scene.video.height)
+        lay = grid.plot(scene)
         self.x = slice(lay.x0, lay.x0 + lay.w)
         self.y = [slice(lay.y0 + r["rows"][0], lay.y0 + r["rows"][1]) for r in results]
         self.last = [None] * len(results)
@@ -110,6 +116,10 @@ class Assembly:
     def arrays(self) -> dict:
         """The bands' per-pixel arrays joined: the whole plot's, row-major, as one map's arrays() would be."""
         return {k: np.concatenate([r["arrays"][k] for r in self.results]) for k in self.results[0]["arrays"]}
+
+    def result(self) -> dict:
+        """What the map's result() would give of the whole plot, for its data (render/maps/data.py)."""
+        return map_class(self.scene).result_of(self.scene, self.arrays(), self.results[0]["t"])
 
     def summary(self) -> dict:
         """What the map's summary() would say of the whole plot, for metadata.json."""

@@ -1,15 +1,16 @@
 """The `poincare` effect: the Poincaré section θ1 = 0 (mod 2π), ω1 > 0 of a double pendulum, found as the
 (θ2, ω2) points where each pendulum crosses it; and the `shell` start. render/draw/section.py draws them.
 
-- **Crossings** are found where the substeps happen (System.advance calls detect() after every step): θ1 is
-  unwrapped, so a step crosses the section upwards where it passes a multiple of 2π while increasing. The
-  crossing is located within the step by cubic Hermite interpolation of the step itself, from the state and
-  its derivative (the system's own force) at both ends: θ1(u) = 2πk is solved by Newton from the chord,
-  then θ2 and ω2 are interpolated at that u. Its error is h⁴/384 times the fourth derivative, below the
-  step's own: tests/test_poincare.py checks crossings against scipy's event location on the independent
-  model within 1e-6 (on poincare_shell at dt ≈ 1 ms they agree within 1e-9 s, rad and rad/s over 6 s), so
-  Hénon's extra step is not needed. An advance records at most SLOTS crossings per pendulum (θ1 would have
-  to turn SLOTS times within one frame to lose one); losses are counted in metadata.
+- **Crossings** are found where the substeps happen (System.advance calls render/physics/crossings.py's
+  detect() after every step; read() here takes them back): θ1 is unwrapped, so a step crosses the section
+  upwards where it passes a multiple of 2π while increasing. The crossing is located within the step by
+  cubic Hermite interpolation of the step itself, from the state and its derivative (the system's own force)
+  at both ends: θ1(u) = 2πk is solved by Newton from the chord, then θ2 and ω2 are interpolated at that u.
+  Its error is h⁴/384 times the fourth derivative, below the step's own: tests/test_poincare.py checks
+  crossings against scipy's event location on the independent model within 1e-6 (on poincare_shell at
+  dt ≈ 1 ms they agree within 1e-9 s, rad and rad/s over 6 s), so Hénon's extra step is not needed. An
+  advance records at most SLOTS crossings per pendulum (θ1 would have to turn SLOTS times within one frame
+  to lose one); losses are counted in metadata.
 - **layout = "shell"** starts every pendulum with the energy of the preset's (theta, omega), on the section:
   θ1 = 0, (θ2, ω2) spread over the section's accessible region by a low-discrepancy (R2) sequence, and ω1 > 0
   solved from the energy. The energy is the reference model's (render/physics/reference.py): it is a quadratic in ω1,
@@ -18,50 +19,13 @@
 import math
 
 import numpy as np
-import taichi as ti
 
-from . import reference, runtime
+from . import reference
 from ..errors import SceneError
 
 SLOTS = 4  # crossings kept per pendulum and advance call
 TAU = 2.0 * math.pi
 PLASTIC = 1.324717957244746  # the R2 sequence's generator: frac(½ + k/p, ½ + k/p²) fills a square evenly
-
-
-def allocate(sim):
-    """The crossing fields of a system whose scene has the effect: this step's crossings per pendulum."""
-    sim.crossings = runtime.field("poincare.crossings", runtime.real(), (sim.n, SLOTS), 3)  # (t in step, θ2, ω2)
-    sim.crossed = runtime.field("poincare.count", ti.i32, sim.n)
-
-
-@ti.func
-def hermite(y0, y1, d0, d1, u):
-    """The cubic through y0, y1 with slopes d0, d1 (per unit of u) at u = 0, 1."""
-    return (y0 + u * (d0 + u * (3.0 * (y1 - y0) - 2.0 * d0 - d1 + u * (2.0 * (y0 - y1) + d0 + d1))))
-
-
-@ti.func
-def hermite_slope(y0, y1, d0, d1, u):
-    return d0 + u * (6.0 * (y1 - y0) - 4.0 * d0 - 2.0 * d1 + 3.0 * u * (2.0 * (y0 - y1) + d0 + d1))
-
-
-@ti.func
-def detect(sys: ti.template(), i, s, q0, v0, q1, v1, h):
-    """Record pendulum i's crossing of the section in substep s (from q0, v0 to q1, v1; D × 1), if any."""
-    k0, k1 = ti.floor(q0[0, 0] / TAU), ti.floor(q1[0, 0] / TAU)
-    if k1 > k0 and i < sys.n:
-        a0, a1 = sys.force(q0, v0), sys.force(q1, v1)
-        y0, y1 = q0[0, 0] - k1 * TAU, q1[0, 0] - k1 * TAU  # below and at or above the section
-        d0, d1 = h * v0[0, 0], h * v1[0, 0]
-        u = y0 / (y0 - y1)
-        for _ in range(4):  # Newton from the chord: its error is O(h²), squared each time
-            u = ti.min(ti.max(u - hermite(y0, y1, d0, d1, u) / hermite_slope(y0, y1, d0, d1, u), 0.0), 1.0)
-        th2 = hermite(q0[1, 0], q1[1, 0], h * v0[1, 0], h * v1[1, 0], u)
-        w2 = hermite(v0[1, 0], v1[1, 0], h * a0[1, 0], h * a1[1, 0], u)
-        k = sys.crossed[i]
-        if k < SLOTS:
-            sys.crossings[i, k] = ti.Vector([(s + u) * h, th2, w2])
-        sys.crossed[i] = k + 1
 
 
 def read(sim, t0: float) -> tuple[np.ndarray, ...]:

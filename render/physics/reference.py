@@ -39,7 +39,7 @@ def params(src) -> Params:
 
 
 def initial_state(scene) -> tuple[np.ndarray, np.ndarray]:
-    """The fan's initial (q, v) in float64: the last link of pendulum i has θ − spread·i/count (DESIGN.md)."""
+    """The fan's initial (q, v) in float64: the last link of pendulum i has θ − spread·i/count (docs/presets.md)."""
     p = params(scene)
     pend, links = scene.pendulums, len(p.lengths)
     n = pend.count

@@ -1,7 +1,10 @@
-"""The systems: every module in render/physics/systems/ that defines SYSTEM (a System subclass) is one.
+"""The systems: every module in render/physics/systems/ that defines SYSTEM (a Plan subclass) is one, and the
+module of the same name in render/physics/kernels/ is its Taichi side (KERNELS).
 
-Adding a system is adding a module there; nothing else names it. Everything that depends on the kind of
-pendulum (the scene loader, simulate, accuracy, bench, quality, the canvas) asks this registry.
+Adding a system is adding those two modules; nothing else names it. Everything that depends on the kind of
+pendulum (the scene loader, simulate, accuracy, bench, quality, the canvas) asks this registry. get() gives the
+declaration and the plan, which import no Taichi (listing presets, validating and refusing a scene start none);
+kernels() the Taichi class, which only stepper.Run builds with fields.
 """
 from __future__ import annotations
 
@@ -28,9 +31,11 @@ def names() -> tuple[str, ...]:
 
 
 def get(name: str):
-    """The System subclass registered under `name` (KeyError if none)."""
+    """The Plan subclass registered under `name` (KeyError if none): its declaration, and its plan when built."""
     return _all()[name]
 
 
-def classes() -> list:
-    return list(_all().values())
+def kernels(name: str):
+    """The Taichi class of system `name`: its module in render/physics/kernels/ (imported now, with Taichi)."""
+    module = get(name).__module__.rsplit(".", 1)[1]
+    return importlib.import_module(f"{__package__}.kernels.{module}").KERNELS

@@ -75,14 +75,6 @@ def _guard(x, s, c):
 
 
 @ti.func
-def _poly_f64(r):
-    z = r * r
-    s = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))))
-    c = 1.0 - 0.5 * z + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))))
-    return s, c
-
-
-@ti.func
 def sincos_f64(x):
     """f64, fdlibm's way (< 1 ulp): a double-double r + rr (π/2 to 119 bits) and kernels that take the tail."""
     j = ti.round(x * TWO_OVER_PI)

@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from . import integrators, reference
-from .system import DEFAULT_MAX_DRIFT
+from .integrators import DEFAULT_MAX_DRIFT
 
 MARGIN = 1.25  # over the largest sampled radius: covers what falls between the samples
 SAMPLES = 1024  # random configurations

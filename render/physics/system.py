@@ -1,73 +1,38 @@
-"""What every pendulum system shares: its declaration for the registry, state fields, the advance and energy
-kernels, the drawing contract and the watchdog.
+"""The Taichi side every pendulum system shares: state fields, the advance and energy kernels, the drawing
+contract's points and the watchdog, on top of the system's Plan (render/physics/plan.py: its declaration,
+step and initial state).
 
-A system module (render/physics/systems/) subclasses System, declares what the registry and the scene loader need as
-class attributes, and writes its physics once as Taichi functions:
+A system's Taichi class (render/physics/kernels/) subclasses its Plan (render/physics/systems/) and System,
+and writes its physics once as Taichi functions:
 - accel(q, v) on lane matrices (row k = coordinate k, column l = pendulum l of a group), so the same code
   runs one pendulum or several packed side by side; trig through self.sincos, not ti.sin;
 - energy(q, v) and points(q) for one pendulum's vectors.
-The integrators (render/physics/integrators.py) call force(); the canvas reads only points() and the Python-side
-contract (LINKS, bob_sizes(), reach(), lengths).
+The steps (render/physics/steps.py) call force(); the canvas reads only points() and the Python-side
+contract (LINKS, bob_sizes(), reach(), lengths). Only stepper.Run builds one with fields.
 """
-
-import math
 
 import numpy as np
 import taichi as ti
 
-from . import grid, integrators, keys, poincare, runtime
+from . import crossings, runtime, steps
+from .plan import Plan
 from .sincos import sincos
 from ..errors import SimulationError
 
-DEFAULT_MAX_DRIFT = integrators.DEFAULT_MAX_DRIFT  # the energy watchdog's tolerance unless a scene sets one
 BLOWN = 100.0  # a relative energy drift this large is a blow-up, not a drift
 
 
-class System(runtime.Launcher):
-    """Base of @ti.data_oriented systems."""
+class System(Plan, runtime.Launcher):
+    """Base of the systems' @ti.data_oriented classes."""
 
-    # ---- the declaration (class attributes: read without a Taichi runtime) ----
-    SYSTEM = ""  # the preset's `system` value
-    NAME = ""  # prefix of this system's kernel names in metadata ("rigid_advance")
-    DOC = ""  # one line for `pendulum presets` and docs/presets.md
-    D = 0  # coordinates per pendulum in q (and v)
-    LINKS: tuple[str, ...] = ()  # drawing contract: what joins pivot→bob 1→bob 2...: "rod" | "spring"
-    ANGLES = False  # q holds the links' angles (a fractal can colour by them)
-    KEYS: dict = {}  # preset keys under [pendulums] beyond the chain's (keys.chain) and the common ones
-    METHODS: tuple[str, ...] = ()  # integrators this system supports
-    DEFAULT_EFFECTS: tuple[str, ...] = ()
-    STATE: dict = {}  # `simulate`'s arrays: name -> ("q" | "v", shape per pendulum)
-    REFERENCE = ""  # the independent model in render/physics/reference.py ("chain" | "springs")
-    ERROR_UNIT = ""  # what a trajectory error is measured in, for reports
-    ACCURACY_CASE: tuple[str, float] = ("", 0.0)  # (preset, horizon s) that `pendulum accuracy` measures
-    ACCURACY_LADDER: tuple[float, ...] = ()  # dt rungs of the work-precision chart
-    CHUNK = 16  # pendulums per group of the advance kernel in f64; f32 takes twice as many (see advance)
-
-    @classmethod
-    def preset_keys(cls) -> dict:
-        return keys.chain(len(cls.LINKS), cls.KEYS)
-
-    # ---- one instance per run ----
     def __init__(self, scene, subset=None, allocate: bool = True):
-        """The scene's pendulums, or only those at the indices `subset` (the step is the whole scene's).
-        Without `allocate` it only plans: the initial state and the step, no Taichi field."""
-        self.scene = scene
-        p = scene.pendulums
-        self.count = p.count
-        self.method = scene.integrator.method
+        """The plan (Plan.start), and its state in Taichi fields. Without `allocate` only the plan and the
+        Taichi functions, no field: a twin whose functions another kernel calls (tangent.libm_twin)."""
+        q0, v0 = self.start(scene, subset)
         self.libm = scene.integrator.trig == "libm"
         self.damped = scene.has("damping")
-        self.damping = p.damping
-        self.poincare = scene.has("poincare")  # crossings of the section recorded per substep (render/physics/poincare.py)
-        self.g = p.gravity
-        self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
-        q0, v0 = self.initial_state()
-        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
-                                                     self.energy_limit(q0, v0, self.method))
-        integrators.check_substeps(scene, self.substeps, self.h)  # "auto" is known only now: before any work
-        if subset is not None:
-            q0, v0 = q0[subset], v0[subset]
-        self.n, self.subset = len(q0), subset
+        self.damping = scene.pendulums.damping
+        self.poincare = scene.has("poincare")  # crossings of the section recorded per substep (crossings.py)
         if not allocate:
             return
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
@@ -78,7 +43,7 @@ class System(runtime.Launcher):
         self.v = runtime.field("state.v", real, self.n, self.D)
         self.bad = runtime.field("watchdog.bad", ti.i32, ())
         if self.poincare:
-            poincare.allocate(self)
+            crossings.allocate(self)
         self.load(q0, v0)
         if scene.has("energy"):
             self.floor = self.energy_floor()
@@ -112,52 +77,7 @@ class System(runtime.Launcher):
         """`substeps` steps of h (default: the scene's step)."""
         (self.advance_libm if self.libm else self.advance)(substeps, self.h if h is None else h)
 
-    # --------------------------------------------------------------- per-system parts (Python)
-    def omega_max(self, q0: np.ndarray, v0: np.ndarray) -> float:
-        """A bound (rad/s) on the fastest rate of the undamped linearised dynamics over the whole run from these
-        initial states: the step limit is the method's limit over it plus the damping rate (integrators.timestep,
-        render/physics/stability.py)."""
-        raise NotImplementedError
-
-    def energy_limit(self, q0: np.ndarray, v0: np.ndarray, method: str) -> float:
-        """The longest step (s) at which `method` keeps the energy gain of the whole run from these initial
-        states within integrator.max_drift, where it gains energy on this system (integrators.Method.energy_gain);
-        inf where it does not."""
-        return math.inf
-
-    def deviation(self, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
-        """How far apart two states are, per pendulum, in the unit of integrator.tolerance: rad on any angle."""
-        return np.abs(qa - qb).max(-1)
-
-    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
-        raise NotImplementedError
-
-    def reach(self) -> float:
-        """How far from the pivot a bob can get, in m: the canvas frames the scene by it."""
-        raise NotImplementedError
-
-    def bob_sizes(self) -> tuple[float, ...]:
-        """Each bob's radius relative to the largest (as the cube root of its mass)."""
-        top = max(self.masses)
-        return tuple((m / top) ** (1 / 3) for m in self.masses)
-
-    def initial_angles(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per pendulum, the angle and rate of every link, each (N, links).
-
-        A fan: the preset's angles, the last link's minus spread·i/count; a grid: θ1 × θ2 over [−π, π]², one
-        per pixel of the map's plot (render/physics/grid.py)."""
-        p, n, links = self.scene.pendulums, self.count, len(self.LINKS)
-        th = np.array([[p[f"theta{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
-        w = np.array([[p[f"omega{k}"] for k in range(1, links + 1)]] * n, dtype=np.float64)
-        if p.layout == "grid":
-            th, w = grid.grid_state(self.scene, th, w)
-        elif p.layout == "shell":
-            poincare.shell_start(self.scene, th, w)
-        else:
-            th[:, -1] = th[:, -1] - p.spread * np.arange(n, dtype=np.float64) / n
-        return th, w
-
-    # --------------------------------------------------------------- per-system parts (Taichi)
+    # --------------------------------------------------------------- per-system parts
     @ti.func
     def accel(self, q, v):
         """Accelerations for lane matrices q, v (D × pendulums)."""
@@ -241,11 +161,11 @@ class System(runtime.Launcher):
                 if ti.static(self.poincare):
                     Q0, V0 = Q, V
                 for lane in range(B):  # the loop LLVM vectorises
-                    q, v = integrators.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                    q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
                     Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
                 if ti.static(self.poincare):  # in a loop of its own, so that its branch leaves the step's SIMD
                     for lane in range(B):
-                        poincare.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                        crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
                                         ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
                                         ti.Matrix.cols([V[:, lane]]), h)
             for lane in range(B):
@@ -265,9 +185,9 @@ class System(runtime.Launcher):
                 self.crossed[i] = 0
             for s in range(substeps):
                 q0, v0 = q, v
-                q, v = integrators.step(self, q, v, h)
+                q, v = steps.step(self, q, v, h)
                 if ti.static(self.poincare):
-                    poincare.detect(self, i, s, q0, v0, q, v, h)
+                    crossings.detect(self, i, s, q0, v0, q, v, h)
             self.q[i], self.v[i] = q[:, 0], v[:, 0]
             self.watch(i, q, v)
 
@@ -296,10 +216,6 @@ class System(runtime.Launcher):
         ti.atomic_max(self.drift[None], ti.abs(d))
         if not ti.abs(d) < 1e30:
             ti.atomic_min(self.bad[None], i)
-
-    def energy_floor(self) -> float:
-        """Energy scale for pendulums whose own energy is near zero."""
-        return 1e-3 * sum(self.masses) * max(self.g, 1.0) * sum(self.lengths)
 
     # --------------------------------------------------------------- host side (for render/physics/stepper.py)
     def measure_energy(self, first: bool = False):

@@ -3,9 +3,9 @@
     flow = TangentFlow(sim)          # sim: an allocated System (its q, v are the state at the frame's start)
     images = flow.frame(basis)       # basis (n, 2D, k) -> DΦ·basis, before the frame loop steps sim
 
-What is differentiated: one frame of the scene's own integrator (integrators.step, `substeps` steps of h)
+What is differentiated: one frame of the scene's own integrator (steps.step, `substeps` steps of h)
 over the system's own force, wrapped in canonical coordinates:
-    (q, p) -> (q, v = velocities(q, p)) -> substeps of integrators.step -> (q, momenta(q, v)).
+    (q, p) -> (q, v = velocities(q, p)) -> substeps of steps.step -> (q, momenta(q, v)).
 Taichi's forward mode (ti.ad.FwdMode) carries a dual number for every tangent vector through that kernel,
 so the result is the tangent map of the numerical flow to round-off, not a finite difference, and no
 physics is written twice: the integrator, force(), momenta() and velocities() are the system's.
@@ -34,7 +34,7 @@ import contextlib
 import numpy as np
 import taichi as ti
 
-from . import integrators, registry
+from . import integrators, registry, steps
 from ..errors import SceneError
 
 
@@ -51,7 +51,7 @@ def check_method(scene):
 def libm_twin(sim):
     """The system's parameters with libm's sin/cos, which forward mode differentiates (no fields)."""
     twin = sim.scene.replace(integrator={"trig": "libm"})
-    return registry.get(twin.system)(twin, subset=sim.subset, allocate=False)
+    return registry.kernels(twin.system)(twin, subset=sim.subset, allocate=False)
 
 
 @contextlib.contextmanager
@@ -92,7 +92,7 @@ class TangentFlow:
             q = q0 + ti.Matrix.cols([dx[:D]])
             v = sys.velocities(q, p)
             for _ in range(substeps):
-                q, v = integrators.step(sys, q, v, h)
+                q, v = steps.step(sys, q, v, h)
             p = sys.momenta(q, v)
             self.out[e] = ti.Vector([q[c, 0] for c in ti.static(range(D))] + [p[c, 0] for c in ti.static(range(D))])
 

@@ -75,17 +75,6 @@ class Certificate:
             d["lyapunov"] = self.lyapunov
         return d
 
-    def line(self) -> str:
-        """One line for the end of a render."""
-        first, median = self.faithful_until_s, self.median_until_s
-        return (f"faithful until {_t(first, self.duration)} (median {_t(median, self.duration)}, "
-                f"{100 * self.fraction_faithful:.0f} % of {len(self.indices)} pendulums through "
-                f"{self.duration:g} s) at {self.tolerance:g} {self.unit}")
-
-
-def _t(t: float, duration: float) -> str:
-    return f"the end ({duration:g} s)" if t >= duration else f"{t:.2f} s"
-
 
 def subsample(count: int, limit: int = SUBSAMPLE) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, count - 1, min(count, limit))).astype(np.int64))
@@ -138,7 +127,7 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
         indices = subsample(scene.pendulums.count)
     shadow_first = scene.integrator.precision != "f64"  # then the render's own init comes last
     if shadow_first:
-        plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)  # the step only
+        plan = registry.get(scene.system)(scene, subset=indices[:1])  # the step only
         ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads)
     run = Run(scene, arch, threads, subset=indices)
     main = record(run, scene.frames, watch=True)  # a blow-up, not an untrue run: the watchdog says so

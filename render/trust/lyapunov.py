@@ -83,7 +83,7 @@ def check(scene, indices: np.ndarray):
     if scene.frames < 2 * BLOCKS + 1:
         raise SceneError(f"{scene.source}: video.duration: {scene.video.duration:g} s at {scene.video.fps} fps "
                          f"gives {scene.frames} frames; the spectrum's error needs at least {2 * BLOCKS + 1}")
-    plan = registry.get(scene.system)(scene, subset=indices[:1], allocate=False)
+    plan = registry.get(scene.system)(scene, subset=indices[:1])
     steps = scene.frames * plan.substeps * len(indices) * (1 + 2 * plan.D * TANGENT_COST)
     if steps > STEP_LIMIT:
         raise SceneError(f"{scene.source}: video.duration: the spectrum needs about {steps:.3g} "

@@ -38,7 +38,7 @@ def cost(s: dict, fps: int) -> float:
 
 
 def offered(scene, plan) -> list[dict]:
-    """candidates() for the scene's planned System (allocate=False): its rate bound and each method's energy
+    """candidates() for the scene's Plan (registry.get): its rate bound and each method's energy
     limit, from its own initial states."""
     q0, v0 = plan.initial_state()
     return candidates(scene, plan.omega_max(q0, v0), {m: plan.energy_limit(q0, v0, m) for m in plan.METHODS})
@@ -61,7 +61,7 @@ def choose(scene, arch: str = "cpu", threads=None):
     if level is None:
         return scene, {"level": None, "chosen": _as_dict(scene.integrator), "why": "the preset's own settings"}
     cls = registry.get(scene.system)
-    plan = cls(scene, allocate=False)
+    plan = cls(scene)
     cands = offered(scene, plan)
     if not cands:
         raise SceneError(f"{scene.source}: --quality {level}: no integrator is stable for this scene at the steps "

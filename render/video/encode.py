@@ -16,7 +16,6 @@ import queue
 import subprocess
 import tempfile
 import threading
-import time
 from pathlib import Path
 
 import imageio_ffmpeg
@@ -123,7 +122,6 @@ class _Target:
         self.small = small  # the GIF's (width, height): it is fed frames of that size only
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
-        self.busy_s = 0.0  # time this writer spent handing frames to ffmpeg (blocked while ffmpeg is behind)
         try:
             fcntl.fcntl(proc.stdin.fileno(), F_SETPIPE_SZ, PIPE_BYTES)
         except (OSError, AttributeError):
@@ -139,18 +137,16 @@ class _Target:
                 return
             if self.error is not None:
                 continue  # keep draining so the producer never blocks on a dead encoder
-            t = time.perf_counter()
             try:
                 view = memoryview(np.ascontiguousarray(frame)).cast("B")
                 while view:  # os.write releases the GIL while it blocks on the pipe
                     view = view[os.write(fd, view):]
             except BaseException as e:  # a dead ffmpeg: report it from the main thread
                 self.error = e
-            self.busy_s += time.perf_counter() - t
 
 
 class Encoder:
-    """Writes `frames` to out_dir/NAME.<fmt> for each format; use as a context manager or call close/abort."""
+    """Writes `frames` to out_dir/NAME.<fmt> for each format: write() each frame, then close(), or abort()."""
 
     def __init__(self, out_dir: Path, name: str, video, frames: int, formats=None):
         self.targets: list[_Target] = []
@@ -182,20 +178,6 @@ class Encoder:
         except BaseException:
             self.abort()
             raise
-
-    @property
-    def busy_s(self) -> float:
-        """Seconds the busiest writer spent feeding ffmpeg."""
-        return max((t.busy_s for t in self.targets), default=0.0)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, kind, value, tb):
-        if kind is None:
-            self.close()
-        else:
-            self.abort()
 
     def write(self, frame: np.ndarray, small: np.ndarray | None = None):
         """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind. `small` is the

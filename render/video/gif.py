@@ -4,8 +4,9 @@ A 720p frame area-averaged down to 352 px turns its 6x13 and 10x20 text into gre
 into faint smears. So, where the GIF's size or rate is not the video's, a second canvas of the GIF's size
 draws the same simulation (the same System, the same states: nothing is simulated twice) for the frames the
 GIF keeps, with a HUD laid out for that height (render/draw/hud.py picks its font by the frame's height) and
-trails that fade per GIF frame at the preset's trail_seconds. The frames the GIF skips still stamp their
-stretch of the path into its trails, so a trail is the curve the bob drew, not chords between GIF frames.
+trails that fade per GIF frame at the preset's trail_seconds. The frames the GIF skips still leave their
+stretch of the path in its trails, so a trail is the curve the bob drew, not chords between GIF frames: the
+canvas keeps where the last bob was at each (Canvas.follow) and stamps them with the next frame it draws.
 
 A comparison's GIF is a second split screen at the GIF's size drawn from the first one's recorded runs.
 A map's pixels are its pendulums, so a second map would be a second simulation: a map's GIF frame is the
@@ -74,18 +75,19 @@ def _average(a: np.ndarray, m: int) -> np.ndarray:
     return (whole + cut[1:] - cut[:-1]) * (m / n)
 
 
-def _stamp(canvas):
-    """A video frame the GIF skips: the bobs' path since the last one into the GIF canvas's trails, drawn
-    (and faded) with the next frame the GIF keeps. Nothing before the GIF's first frame: there is no path yet."""
-    if canvas.trails and canvas.frame_no:
-        canvas.launch("bob_pixels")
-        canvas.launch("stamp_trails", 0)
+def gap(repeats: list[int]) -> int:
+    """The most video frames in a row that the GIF skips."""
+    run = most = 0
+    for n in repeats:
+        run = 0 if n else run + 1
+        most = max(most, run)
+    return most
 
 
 class _Canvas:
     """A fan's GIF: a second Canvas of the GIF's size over the render's own System."""
 
-    def __init__(self, src, w: int, h: int, fps: int):
+    def __init__(self, src, w: int, h: int, fps: int, skips: int):
         from ..draw.canvas import Canvas
         from ..draw.hud import Info
 
@@ -94,15 +96,16 @@ class _Canvas:
         self.fps = v.fps
         info = dataclasses.replace(Info.of(src.scene, src.sim.h, src.cert), one_line=True)
         self.canvas = Canvas(small, src.sim, info)
+        self.canvas.follow(skips)
 
     def skip(self, f: int):
-        _stamp(self.canvas)
+        self.canvas.skip()
 
     def draw(self, f: int) -> np.ndarray:
         return self.canvas.draw(None, f / self.fps)
 
 
-def _split(src, w: int, h: int, fps: int):
+def _split(src, w: int, h: int, fps: int, skips: int):
     """A comparison's GIF: a SplitScreen of the GIF's size sharing the video's recorded runs (pass 1 is not run
     again), its panels drawn at the GIF's rate with the video's clock."""
     from ..draw.split import LARGE, Replay, SplitScreen, label_band, layout
@@ -114,8 +117,9 @@ def _split(src, w: int, h: int, fps: int):
             return self.canvas.draw(out, self.index / src.scene.video.fps)
 
         def skip(self, f: int):
-            self.sim.q.from_numpy(self.q[f])
-            _stamp(self.canvas)
+            if self.canvas.tracing:  # else there is nothing to keep (and from_numpy is a launch too)
+                self.sim.q.from_numpy(self.q[f])
+                self.canvas.skip()
 
     class Split(SplitScreen):
         def __init__(self):  # the video's split screen did SplitScreen.__init__'s work: share it
@@ -126,6 +130,8 @@ def _split(src, w: int, h: int, fps: int):
             self.panels = [Panel(sized(run["scene"], pw, ph), run["q"], run["cert"], src.arch, src.threads,
                                  keep_log=True, keep_clear=[(0, 0, pw - 1, label_band(self.scene, ph) - 1)])
                            for run, (_, _, pw, ph) in zip(self.runs, self.rects)]
+            for p in self.panels:
+                p.canvas.follow(skips)
             self.buffers = [p.canvas.new_frame() for p in self.panels]
             self.size = "10x20" if self.rects[0][3] >= LARGE else "6x13"
             self.timings = {"draw": 0.0}
@@ -157,7 +163,8 @@ class Frames:
         scene, fps = src.scene, rate(video)
         if ((self.w, self.h), fps) != ((video.width, video.height), video.fps) and not scene.fractal \
                 and not scene.has("poincare"):
-            self.own = _split(src, self.w, self.h, fps) if scene.compare else _Canvas(src, self.w, self.h, fps)
+            own = _split if scene.compare else _Canvas
+            self.own = own(src, self.w, self.h, fps, gap(self.repeats))
 
     def frame(self, f: int, video_frame: np.ndarray) -> np.ndarray | None:
         t = time.perf_counter()

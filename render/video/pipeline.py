@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from . import audio
-from ..trust import certify, quality
+from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
 from .atomic import digest, replacing, write_atomic
@@ -95,6 +95,10 @@ class Source:
         self.timings["draw"] += time.perf_counter() - t
         return frame
 
+    def run_meta(self) -> dict:
+        """What metadata.json says of the simulation (metadata())."""
+        return run_meta(self.scene, self.sim, self.cert, self.chosen)
+
 
 def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
     """A scene simulated to the end without drawing, as `render` simulates it (prepare(), the watchdog): a
@@ -117,9 +121,8 @@ def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
     steady = scene.frames - 2
     cost = (timings["simulate"] - warm) * scene.video.fps / steady if steady > 0 else timings["simulate"] / \
         scene.video.duration
-    return {"scene": scene, "chosen": chosen, "cert": cert, "timings": timings, "q": q, "cost": cost,
-            "integrator": integrator_meta(scene, sim), "energy": energy_meta(scene, sim),
-            "kernels": list(runtime.launched), "fields": dict(runtime.allocated)}
+    return {**run_meta(scene, sim, cert, chosen), "scene": scene, "timings": timings, "q": q, "cost": cost,
+            "fields": dict(runtime.allocated)}
 
 
 def open_source(scene, arch: str = "cpu", threads: int | None = None, cluster=None, bands: int | None = None):
@@ -127,11 +130,30 @@ def open_source(scene, arch: str = "cpu", threads: int | None = None, cluster=No
     `cluster` (a Client) a map's frames made in `bands` tiles there (render/video/tiled.py)."""
     if cluster is not None:
         from .tiled import TiledSource
-        return TiledSource(prepare(scene, arch, threads), cluster, bands, arch, threads)
+        src = TiledSource(prepare(scene, arch, threads), cluster, bands, arch, threads)
+        src.run_meta = lambda: run_meta(src.scene, src.sim, src.cert, src.chosen)  # a Source's, of its plan
+        return src
     if not scene.compare:
         return Source(scene, arch, threads)
     from ..draw.split import SplitScreen
     return SplitScreen(scene, lambda variant: record(variant, arch, threads), arch, threads)
+
+
+@contextmanager
+def map_data(src, out_dir: Path):
+    """A map's NAME.npz (render/maps/data.py), its pixels' data at the last frame, written beside the video
+    before the block and published after it succeeds (removed if it fails); yields the {file: bytes} it adds
+    to the outputs, filled once published. Nothing for a fan."""
+    written = {}
+    if not src.scene.fractal:
+        yield written
+        return
+    from ..maps import data
+    path = out_dir / f"{src.name}.npz"
+    with replacing(path, suffix=".npz") as tmp:  # savez wants the .npz
+        np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
+        yield written
+    written[path.name] = path.stat().st_size
 
 
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
@@ -165,17 +187,18 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()
-            sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
+            with map_data(src, out_dir) as data:  # published once the videos are
+                sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
+            sizes.update(data)
             timings["encode"] += time.perf_counter() - t
         except BaseException:
             enc.abort()
             raise
         timings["total"] = time.perf_counter() - t_start
         sha256 = {f: digest(out_dir / f) for f in sizes}
+        meta = metadata(scene, src.arch, src.run_meta(), timings, sizes, sha256)
         if scene.compare:
-            meta = src.metadata(header(scene, src.arch), timings, sizes, sha256)
-        else:
-            meta = metadata(scene, src.sim, src.arch, timings, sizes, src.cert, src.chosen, sha256)
+            meta["compare"] = src.compare_meta()
         if scene.fractal:
             meta["map"] = src.canvas.summary()
         if scene.has("poincare"):
@@ -187,8 +210,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
 
 
 def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = False) -> dict:
-    """The state at every frame time (DESIGN.md: t, theta/omega or pos/vel, energy), as float64 arrays in
-    the returned info's "arrays", and written to out_file (a .npz) unless that is None."""
+    """The state at every frame time (t, theta/omega or pos/vel, energy: docs/output-format.md), as float64
+    arrays in the returned info's "arrays", and written to out_file (a .npz) unless that is None."""
     if not scene.has("energy"):
         scene = scene.replace(effects=[*scene.effects, "energy"])  # the file carries energy
     scene, chosen, cert, before = prepare(scene, arch, None)
@@ -210,12 +233,19 @@ def simulate(scene, out_file: Path | None, arch: str = "cpu", progress: bool = F
             np.savez_compressed(tmp, **arrays)
     return {"frames": scene.frames, "kernels": list(runtime.launched), "timings_s": timings,
             "integrator": integrator_meta(scene, sim), "faithfulness": cert.to_dict(), "quality": chosen,
-            "line": cert.line(), "arrays": arrays}
+            "line": faithful.sentence(cert.to_dict(), scene.video.duration), "arrays": arrays}
 
 
 def integrator_meta(scene, sim) -> dict:
     return {"method": scene.integrator.method, "dt": sim.h, "dt_requested": scene.integrator.dt,
             "substeps": sim.substeps, "precision": scene.integrator.precision}
+
+
+def run_meta(scene, sim, cert, chosen: dict) -> dict:
+    """What metadata.json says of a run (metadata()): `integrator` (as run), `energy`, `cert`, `chosen` (the
+    --quality choice) and the `kernels` launched so far."""
+    return {"integrator": integrator_meta(scene, sim), "energy": energy_meta(scene, sim), "cert": cert,
+            "chosen": chosen, "kernels": list(runtime.launched)}
 
 
 def header(scene, arch: str) -> dict:
@@ -242,19 +272,21 @@ def energy_meta(scene, sim) -> dict | None:
     return {"initial_total": float(sim.e0.to_numpy().sum()), "max_rel_drift": float(sim.drift[None])}
 
 
-def metadata(scene, sim, arch: str, timings: dict, sizes: dict, cert, chosen: dict,
-             sha256: dict | None = None) -> dict:
+def metadata(scene, arch: str, run: dict, timings: dict, sizes: dict, sha256: dict) -> dict:
+    """metadata.json (docs/output-format.md) of a render or a comparison: the header, what `run` says of the
+    simulation (Source.run_meta(), or a comparison's SplitScreen.run_meta()), the Taichi fields of the whole
+    render, the timings and the files. A comparison adds its own "compare" after it."""
     return {
         **header(scene, arch),
-        "integrator": integrator_meta(scene, sim),
+        "integrator": run["integrator"],
         "effects": list(scene.effects),
-        "kernels": list(runtime.launched),
-        "field_bytes": sum(runtime.allocated.values()),
+        "kernels": list(dict.fromkeys(run["kernels"] + list(runtime.launched))),  # a comparison's variants' first
+        "field_bytes": sum(runtime.allocated.values()),  # a comparison's drawing pass; each variant's in "compare"
         "fields": dict(runtime.allocated),
-        "energy": energy_meta(scene, sim),
-        "faithfulness": cert.to_dict(),
-        "quality": chosen,
+        "energy": run["energy"],
+        "faithfulness": run["cert"].to_dict(),
+        "quality": run["chosen"],
         "timings_s": {k: round(val, 4) for k, val in timings.items()},
         "outputs": sizes,
-        "outputs_sha256": sha256 or {},  # file name -> sha256: `batch` re-renders a file changed in place
+        "outputs_sha256": sha256,  # file name -> sha256: `batch` re-renders a file changed in place
     }

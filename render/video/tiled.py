@@ -23,6 +23,7 @@ from contextlib import contextmanager
 from ..errors import BatchError, SceneError, SimulationError
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
+CONNECT_TIMEOUT = "10s"  # how long Client keeps trying a scheduler (it retries a refused connection till then)
 
 
 def scheduler_address(text: str | None) -> str | None:
@@ -43,7 +44,7 @@ def connect(address: str):
     """A Client of the Dask scheduler at `address`; BatchError (exit 1) when it cannot be reached."""
     from dask.distributed import Client
     try:
-        return Client(address, timeout="10s", set_as_default=False)
+        return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...)
         raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
 
@@ -92,9 +93,9 @@ class TiledSource:
 
         self.scene, self.chosen, self.cert, before = prepared
         scene = self.scene
-        self.sim = registry.get(scene.system)(scene, allocate=False)  # its step, for metadata; nothing allocated
+        self.sim = registry.get(scene.system)(scene)  # its plan: the step, for metadata; no Taichi field
         self.name, self.frames, self.index = scene.name, scene.frames, -1
-        lay = grid.layout(scene.video.width, scene.video.height)
+        lay = grid.plot(scene)
         rows = tiles.bands(lay.h, bands or sum(client.nthreads().values()) or 1)
         nonce, digest = os.urandom(4).hex(), scene.hash()
         t = time.perf_counter()
@@ -115,7 +116,7 @@ class TiledSource:
             for name, size in r["fields"].items():
                 runtime.allocated[name] = runtime.allocated.get(name, 0) + size
         self.assembly = tiles.Assembly(scene, results)
-        self.canvas = self  # what pipeline.render asks a map's canvas for: summary()
+        self.canvas = self  # what pipeline.render asks a map's canvas for: summary(), result()
 
     def collect(self, futures: list, client) -> list[dict]:
         """The bands' results, top first, as they finish; the first failure cancels the others and raises."""
@@ -140,6 +141,10 @@ class TiledSource:
     def summary(self) -> dict:
         """The map's summary() of the whole plot, and how its tiles were made."""
         return {**self.assembly.summary(), "tiles": self.tiles}
+
+    def result(self) -> dict:
+        """The map's result() of the whole plot, for its data (render/maps/data.py)."""
+        return self.assembly.result()
 
     def next_frame(self, out=None):
         """The next frame as H×W×3 uint8, put together from the bands."""

@@ -1,1 +1,2 @@
-"""One module per pendulum system; each defines SYSTEM, its System subclass (see render/physics/registry.py)."""
+"""One module per pendulum system; each defines SYSTEM, its Plan subclass (see render/physics/registry.py), and
+imports no Taichi: its Taichi side is the module of the same name in render/physics/kernels/."""

@@ -1,16 +1,15 @@
-"""The elastic double pendulum: two springs (k = stiffness / rest length) and gravity, in Cartesian form."""
+"""The elastic double pendulum: two springs (k = stiffness / rest length) and gravity, in Cartesian form: its
+declaration, plan and framing (Newton's equations, in Taichi: render/physics/kernels/elastic.py)."""
 import math
 
 import numpy as np
-import taichi as ti
 
 from .. import stability
 from ..keys import Real
-from ..system import System
+from ..plan import Plan
 
 
-@ti.data_oriented
-class Elastic(System):
+class Elastic(Plan):
     SYSTEM = "elastic"
     NAME = "spring"
     DOC = "two springs of rest lengths `lengths`, k = stiffness / rest length (Newton in x, y)"
@@ -82,34 +81,6 @@ class Elastic(System):
         c = max(self.initial_energy(), 0.0) + a * a / (2 * self.k1) + b * b / (2 * self.k2)
         stretch = a / self.k1 + b / self.k2 + math.sqrt(2 * c * (1 / self.k1 + 1 / self.k2))
         return self.l1 + self.l2 + stretch
-
-    @ti.func
-    def spring_pull(self, dx, dy, k, rest):
-        """Force on the far end of a spring along (dx, dy) (guarded so a spring of zero length gives no NaN)."""
-        r = ti.sqrt(dx * dx + dy * dy)
-        pull = -k * (r - rest)
-        return pull * dx / ti.max(r, 1e-12), pull * dy / ti.max(r, 1e-12)
-
-    @ti.func
-    def accel(self, q, v):
-        x1, y1, x2, y2 = q[0, :], q[1, :], q[2, :], q[3, :]
-        f1x, f1y = self.spring_pull(x1, y1, self.k1, self.l1)
-        f2x, f2y = self.spring_pull(x2 - x1, y2 - y1, self.k2, self.l2)
-        return ti.Matrix.rows([(f1x - f2x) / self.m1, (f1y - f2y) / self.m1 - self.g,
-                               f2x / self.m2, f2y / self.m2 - self.g])
-
-    @ti.func
-    def energy(self, q, v):
-        p1, p2 = ti.Vector([q[0], q[1]]), ti.Vector([q[2], q[3]])
-        s1, s2 = p1.norm() - self.l1, (p2 - p1).norm() - self.l2
-        kin = 0.5 * self.m1 * (v[0] * v[0] + v[1] * v[1]) + 0.5 * self.m2 * (v[2] * v[2] + v[3] * v[3])
-        springs = 0.5 * self.k1 * s1 * s1 + 0.5 * self.k2 * s2 * s2
-        grav = self.m1 * self.g * (q[1] + self.l1) + self.m2 * self.g * (q[3] + self.l1 + self.l2)
-        return kin + springs + grav
-
-    @ti.func
-    def points(self, q):
-        return ti.Matrix([[q[0], q[1]], [q[2], q[3]]])
 
 
 SYSTEM = Elastic

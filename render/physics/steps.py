@@ -1,0 +1,94 @@
+"""One step of each integration method, written once as Taichi functions (their facts: integrators.METHOD).
+
+A method works on any system: it needs only the system's `force(q, v)` (and, for the implicit midpoint, its
+canonical hooks `momenta`, `velocities`, `momentum_rate` and `p_scale`). States are "lane matrices": row k is
+coordinate k, column l is pendulum l of a group (see System.advance), so a method is plain matrix arithmetic.
+The method is chosen at compile time with ti.static, so a run compiles only the one it uses.
+"""
+import taichi as ti
+
+# Yoshida's 4th-order composition of three velocity-Verlet steps.
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
+YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
+
+
+@ti.func
+def step(sys: ti.template(), q, v, h):
+    """One step of sys.method from (q, v)."""
+    if ti.static(sys.method == "symplectic_euler"):
+        q, v = symplectic_euler(sys, q, v, h)
+    elif ti.static(sys.method == "verlet"):
+        q, v = verlet(sys, q, v, h)
+    elif ti.static(sys.method == "yoshida4"):
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W0 * h)
+        q, v = verlet(sys, q, v, YOSHIDA_W1 * h)
+    elif ti.static(sys.method == "rk2"):
+        q, v = rk2(sys, q, v, h)
+    elif ti.static(sys.method == "rk4"):
+        q, v = rk4(sys, q, v, h)
+    elif ti.static(sys.method == "implicit_midpoint"):
+        q, v = implicit_midpoint(sys, q, v, h)
+    return q, v
+
+
+@ti.func
+def symplectic_euler(sys: ti.template(), q, v, h):
+    """The seed's v += a·h; x += v·h. Symplectic for a separable system (springs) only: on the rigid chain
+    (θ, ω) are not canonical, so its energy error grows slowly (see docs/accuracy.md)."""
+    v += h * sys.force(q, v)
+    return q + h * v, v
+
+
+@ti.func
+def verlet(sys: ti.template(), q, v, h):
+    v += 0.5 * h * sys.force(q, v)
+    q += h * v
+    return q, v + 0.5 * h * sys.force(q, v)
+
+
+@ti.func
+def rk2(sys: ti.template(), q, v, h):
+    """The explicit midpoint rule: a half step of Euler, then the full step with the midpoint's slopes.
+    Two force evaluations per step, second order; between symplectic Euler (1) and rk4 (4) at equal cost."""
+    a1 = sys.force(q, v)
+    vm = v + 0.5 * h * a1
+    return q + h * vm, v + h * sys.force(q + 0.5 * h * v, vm)
+
+
+@ti.func
+def rk4(sys: ti.template(), q, v, h):
+    a1 = sys.force(q, v)
+    q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
+    a2 = sys.force(q2, v2)
+    q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
+    a3 = sys.force(q3, v3)
+    q4, v4 = q + h * v3, v + h * a3
+    a4 = sys.force(q4, v4)
+    return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+
+
+@ti.func
+def column_norm_sqr(m):
+    """|column|² of each lane of a lane matrix."""
+    return ti.Vector([m[:, lane].norm_sqr() for lane in ti.static(range(m.get_shape()[1]))])
+
+
+@ti.func
+def implicit_midpoint(sys: ti.template(), q, v, h):
+    """The midpoint rule in canonical (q, p), solved by fixed-point iteration until every lane moves less
+    than sys.tol (at most 100 sweeps). It is symplectic only in canonical coordinates: applied to (θ, ω) of
+    a rigid chain its symplecticity defect shrinks only like h³ and energy creeps."""
+    p = sys.momenta(q, v)
+    q1, p1 = q + h * v, p + h * sys.momentum_rate(q, v, p)
+    pscale = sys.p_scale(h)
+    for _ in range(100):
+        qm, pm = 0.5 * (q + q1), 0.5 * (p + p1)
+        vm = sys.velocities(qm, pm)
+        qn, pn = q + h * vm, p + h * sys.momentum_rate(qm, vm, pm)
+        err = ti.max(column_norm_sqr(qn - q1), column_norm_sqr(pn - p1) * pscale * pscale).max()
+        q1, p1 = qn, pn
+        if err <= sys.tol * sys.tol:
+            break
+    return q1, sys.velocities(q1, p1)
