@@ -53,7 +53,7 @@ def check(scene, system, out: Path | None, simulate: bool = False):
     its class (registry.get: for the size of its state); `out` is where the output goes (a folder, or the .npz's
     folder; its bench/rates.json gives this machine's rates), None when nothing is written (the API's
     simulate without a file)."""
-    from . import estimate as estimates  # it plans Systems, and system.py imports this module
+    from . import estimate as estimates  # the planners (trust/, physics/): loaded only when a scene is checked
 
     src = scene.source
     need, key, detail = memory(scene, system, simulate)
