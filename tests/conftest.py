@@ -141,3 +141,27 @@ def preset_renders(tmp_path_factory):
         # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.
         mp.setattr(split, "cost", lambda run: 1e-3 * split.integrators.METHOD[run["integrator"]["method"]].order)
         return {p.stem: render_small(p.stem, out) for p in list_presets()}
+
+
+def ocr_line(img, whitelist: str, pattern: str) -> float | None:
+    """The number `pattern` (a regex, group 1) finds in one line of bitmap text that tesseract reads from the crop
+    `img`, or None. A bitmap font's square pixels read poorly as they are: upscaled 4x and softened, dark on
+    light, they read; how soft suits tesseract varies by glyph, so a few blurs are tried in turn."""
+    import re
+    import subprocess
+
+    import imageio.v3 as iio
+    import numpy as np
+    from PIL import Image, ImageFilter
+
+    grey = Image.fromarray(255 - np.asarray(img)[..., :3].max(axis=2))
+    big = grey.resize((4 * grey.width, 4 * grey.height), Image.NEAREST)
+    for blur in (1.5, 1.7, 2.0, 1.2, 2.5):
+        soft = np.pad(np.asarray(big.filter(ImageFilter.GaussianBlur(blur))), 20, constant_values=255)
+        cmd = ["tesseract", "stdin", "stdout", "--psm", "7", "-c", f"tessedit_char_whitelist={whitelist}"]
+        out = subprocess.run(cmd, input=iio.imwrite("<bytes>", soft, extension=".png"), capture_output=True,
+                             check=True).stdout.decode()
+        found = re.fullmatch(pattern, out)
+        if found:
+            return float(found[1])
+    return None

@@ -2,14 +2,13 @@
 its frames are the small canvas's, the pipe never carries a frame larger than gif_width, and the bytes do
 not depend on the thread count."""
 import dataclasses
-import re
 import shutil
-import subprocess
 
 import imageio.v3 as iio
 import numpy as np
 import pytest
 
+from conftest import ocr_line
 from render.config.scene import load
 from render.video import encode, gif, pipeline
 
@@ -62,22 +61,9 @@ def picks(scene) -> list[int]:
 
 # ---------------------------------------------------------------- (1) the clock reads back
 def read_clock(img: np.ndarray) -> float | None:
-    """The clock's seconds in a crop around it, by tesseract; None if it read no clock. A bitmap font's square
-    pixels read poorly as they are: upscaled 4x and softened, dark on light, they read. How soft suits
-    tesseract varies by glyph, so a few blurs are tried in turn until one reads the whole "t = 1.23 s"."""
-    from PIL import Image, ImageFilter
-
-    grey = Image.fromarray(255 - img[..., :3].max(axis=2))
-    big = grey.resize((4 * grey.width, 4 * grey.height), Image.NEAREST)
-    for blur in (1.5, 1.7, 2.0, 1.2, 2.5):
-        soft = np.pad(np.asarray(big.filter(ImageFilter.GaussianBlur(blur))), 20, constant_values=255)
-        cmd = ["tesseract", "stdin", "stdout", "--psm", "7", "-c", "tessedit_char_whitelist=0123456789.ts= "]
-        out = subprocess.run(cmd, input=iio.imwrite("<bytes>", soft, extension=".png"), capture_output=True,
-                             check=True).stdout.decode()
-        found = re.fullmatch(r"\s*t\s*=\s*(\d+\.\d\d)\s*s\s*", out)
-        if found:
-            return float(found[1])
-    return None
+    """The clock's seconds in a crop around it, by tesseract (conftest.ocr_line); None if it read no clock: every
+    blur must read the whole "t = 1.23 s"."""
+    return ocr_line(img, "0123456789.ts= ", r"\s*t\s*=\s*(\d+\.\d\d)\s*s\s*")
 
 
 def clock_read_back(scene, path, crop):

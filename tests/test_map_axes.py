@@ -3,15 +3,12 @@ frame shows, the energy barrier with rates on the axes, and a zoom too narrow fo
 agreeing with DOP853."""
 import json
 import math
-import re
 import shutil
-import subprocess
 
-import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import ocr_line, run_cli
 from render.draw import axes
 from render.errors import SceneError
 from render.maps import fractal
@@ -32,21 +29,9 @@ def number(label: str) -> float:
 
 
 def read_number(img: np.ndarray) -> float | None:
-    """A tick label read back by tesseract from a crop of the frame, as tests/test_gif.py reads its clock: the
-    bitmap font upscaled 4x, softened, dark on light, a few blurs tried in turn; None if none reads a number."""
-    from PIL import Image, ImageFilter
-
-    grey = Image.fromarray(255 - img.max(axis=2))
-    big = grey.resize((4 * grey.width, 4 * grey.height), Image.NEAREST)
-    for blur in (1.5, 1.7, 2.0, 1.2, 2.5):
-        soft = np.pad(np.asarray(big.filter(ImageFilter.GaussianBlur(blur))), 20, constant_values=255)
-        cmd = ["tesseract", "stdin", "stdout", "--psm", "7", "-c", "tessedit_char_whitelist=0123456789.-"]
-        out = subprocess.run(cmd, input=iio.imwrite("<bytes>", soft, extension=".png"), capture_output=True,
-                             check=True).stdout.decode()
-        found = re.fullmatch(r"\s*(-?\d+(\.\d+)?)\s*", out)
-        if found:
-            return float(found[1])
-    return None
+    """A tick label read back by tesseract from a crop of the frame (conftest.ocr_line, as tests/test_gif.py reads
+    its clock); None if none reads a number."""
+    return ocr_line(img, "0123456789.-", r"\s*(-?\d+(\.\d+)?)\s*")
 
 
 def labels_read_back(frame, lay, scene) -> list[tuple[float, float | None]]:
