@@ -11,6 +11,7 @@ from render.video import pipeline
 from render.physics import reference, registry
 from render.physics.stepper import Run
 from render.config.scene import load
+from render.errors import SimulationError
 
 
 def reference_until(scene, indices):
@@ -55,6 +56,24 @@ def test_the_certificate_of_a_large_fan_is_a_histogram_of_a_subsample():
     assert d["certified"] == certify.SUBSAMPLE and d["pendulums"]["first"] == 0 and d["pendulums"]["last"] == 999
     assert sum(d["until_s_histogram"]["counts"]) == certify.SUBSAMPLE
     assert d["shadow"] == {"method": "rk4", "dt": pytest.approx(1 / 10 / 100 / 4), "precision": "f64"}
+
+
+def test_the_same_physics_is_certified_once_per_process_and_other_physics_afresh():
+    scene = load("rigid_chaos", ["pendulums.count=40", "video.duration=2", "video.fps=30"])
+    first = certify.certify(scene)
+    held = len(certify._MEMO)
+    again = certify.certify(scene.replace(name="other", video={"width": 640, "height": 360, "formats": ["gif"]}))
+    assert len(certify._MEMO) == held  # not run again: the frame's size, the formats and the name do not enter it
+    np.testing.assert_array_equal(again.until_s, first.until_s)
+    assert again.initial_error.tobytes() == first.initial_error.tobytes()
+    finer = certify.certify(scene.replace(integrator={"dt": 5e-4}))  # other physics: run afresh
+    assert len(certify._MEMO) == held + 1
+    assert finer.shadow["dt"] < 0.6 * first.shadow["dt"]
+    # a memo hit still refuses an untrue run, naming this scene
+    strict = scene.replace(name="strict", integrator={"min_faithful": 1.0, "tolerance": 1e-12})
+    for name in ("strict", "strict_too"):
+        with pytest.raises(SimulationError, match=name):
+            certify.certify(strict.replace(name=name))
 
 
 def test_metadata_and_the_last_line_carry_the_certificate_and_the_quality(tmp_path):
