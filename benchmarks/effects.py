@@ -23,6 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from render.physics import runtime  # noqa: E402
 from render.physics.stepper import Run  # noqa: E402
 from render.draw.canvas import Canvas  # noqa: E402
 from render.config.scene import load  # noqa: E402

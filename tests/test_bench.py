@@ -230,3 +230,9 @@ def test_effects_table_shows_a_difference_within_the_noise_as_plus_minus():
     trails = effects.best([run(["bobs", "rods", "trails"], 1.0, 4.0)] * 2)  # +1.7: beyond
     text = effects.table([bobs, rods, trails]).splitlines()
     assert [line.split(" | ")[5] for line in text[2:]] == ["", "±", "+1.70"]
+
+
+def test_the_effects_benchmark_measures_a_preset():
+    """benchmarks/effects.py's own measurement (what `make figures` runs), on a few frames."""
+    row = effects.measure("rigid_chaos", ["bobs", "rods"], 4, cpu=True)
+    assert row["sim"] > 0 and row["draw"] > 0 and row["fields"] > 0 and row["kernels"] >= 2, row
