@@ -23,7 +23,7 @@ from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
 from ..config.options import (check_arch, check_out_folder, check_replaceable, check_threads, check_tiles,
-                              check_writable)
+                              check_writable, usable_cores)
 from ..config.vary import VARIANTS, VARYING, vary_refusal
 from .results import RenderResult, Trajectory
 
@@ -98,7 +98,7 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
     if not how:
         meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads)
     else:
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        cores = usable_cores()
         workers = None if address else min(tiles, cores)
         if workers and threads is None:
             threads = max(1, cores // workers)

@@ -27,7 +27,7 @@ from ..physics import registry
 from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_writable, output_name, positive_int,
-                      progress_wanted, thread_count)
+                      progress_wanted, thread_count, usable_cores)
 from ..config.scene import SCHEMA, list_presets, load, parse_override, preset_path
 from ..video.tiled import connect, scheduler_address
 from ..video.version import __version__
@@ -267,7 +267,7 @@ def run(args) -> int:
     jobs_plan = plan(expand_refs(args.presets), args.overrides, parse_sweeps(args.sweep), args.quality)
     check_writable(args.out)
     out_root = args.out.resolve()  # absolute: Dask workers may run elsewhere with another cwd
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    cores = usable_cores()
     rows: dict[str, dict] = {}
     todo = []
     for job in jobs_plan:

@@ -143,6 +143,11 @@ def check_arch(arch) -> str:
     return arch
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (its affinity, where the OS says), for sizing workers."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
 def check_tiles(tiles) -> int | None:
     """The API's tiles=: None or what --tiles accepts (SceneError otherwise)."""
     from .validate import clip
