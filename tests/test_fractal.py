@@ -11,6 +11,7 @@ from render.draw import axes
 from render.trust import certify
 from render.maps import fractal
 from render.physics import grid, reference
+from render.physics.stepper import Run
 from render.video import pipeline
 from render.config.scene import load
 
@@ -99,6 +100,29 @@ def test_the_barrier_is_tight_link_by_link(link):
     assert reference.energy(scene, q, v) == pytest.approx(e, rel=1e-12)
     _, peak = reference_runs(scene, q, v, 2.0, lambda q, v: np.abs(q[:, :, link]).max(0)[None])
     assert peak[0, 0] > np.pi and peak[0, 1] < np.pi, peak
+
+
+@pytest.mark.parametrize("name, sets", [("fractal_flip", []), ("fractal_divergence", [
+    'integrator.method="implicit_midpoint"', "map.epsilon=1e-3"])])  # pairs that part within the 3 s
+def test_a_map_steps_each_pendulum_as_the_systems_advance_until_its_event_and_then_stops(name, sets):
+    """The map's kernel steps its pixels in lanes, as System.advance does, and finds events between the
+    substeps: a pendulum whose event is still ahead stands, to the bit, where the system's own advance puts
+    the same start (the implicit midpoint too, whose solver iterates each pendulum, not each pair, to its
+    tolerance), and one whose event is in has stopped there."""
+    scene = load(name, ["video.width=48", "video.height=48", "video.duration=3", "video.fps=10",
+                        "integrator.min_faithful=0", *sets])
+    mp, sim, _ = run_map(scene)
+    per_point = 2 if scene.fractal == "divergence" else 1
+    pending = np.repeat(mp.event.to_numpy() == fractal.PENDING, per_point)
+    done = np.repeat(mp.event.to_numpy() >= 0, per_point)
+    assert pending.sum() > 100 and done.sum() > 100, (pending.sum(), done.sum())
+    plain = Run(scene)  # a system of its own (the map's is still held), stepped by its advance kernel
+    for _ in plain.frames():
+        pass
+    q_map, q_plain = sim.q.to_numpy(), plain.sim.q.to_numpy()
+    assert q_map[pending].tobytes() == q_plain[pending].tobytes()
+    assert (sim.v.to_numpy()[pending] == plain.sim.v.to_numpy()[pending]).all()
+    assert (q_map[done] != q_plain[done]).any(-1).mean() > 0.9  # stopped at its event, while the plain run went on
 
 
 # ---------------------------------------------------------------- flip times and the trust mask
