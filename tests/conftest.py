@@ -20,6 +20,26 @@ os.environ.setdefault("TI_OFFLINE_CACHE_MAX_SIZE_OF_FILES", str(1 << 30))  # 1 G
 ROOT = Path(__file__).resolve().parent.parent
 
 
+def start_afresh():
+    """Each test module starts with a fresh Taichi runtime and empty in-process memos, as its own process would.
+    Taichi's offline cache keys a compiled kernel by every field allocated before it in the process (their
+    ids count up), so with the history of whatever other modules a worker happened to run first (xdist
+    hands out modules as workers come free), nearly every kernel was compiled anew on every run: a clean
+    clone of an unchanged tree wrote ~3,900 new cache entries. Started afresh, a module allocates the same
+    fields in the same order on every run, and finds its kernels in the cache."""
+    from render.physics import runtime, stability
+    from render.trust import certify
+
+    runtime.forget()
+    certify._MEMO.clear()  # a hit skips the certificate's runs, and with them their fields
+    stability._memo.clear()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def fresh_runtime():
+    start_afresh()
+
+
 # CI installs every tool the tests use (.ci/run), so a skip there is a test that did not run: only the
 # bench-only numba peer may skip. Elsewhere a skip is a missing tool, listed with its reason by `-ra`.
 CI_MAY_SKIP = ("numba",)
@@ -136,6 +156,7 @@ def render_small(name, out, threads=None):
 def preset_renders(tmp_path_factory):
     from render.draw import split
     from render.config.scene import list_presets
+    start_afresh()  # a session fixture is built before the module's own fixtures: the same history on any worker
     out = tmp_path_factory.mktemp("presets")
     with pytest.MonkeyPatch.context() as mp:
         # A comparison's labels show each variant's measured cost, which no two runs share: a fixed one here.

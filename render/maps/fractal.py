@@ -223,8 +223,8 @@ class Map(runtime.Launcher):
         loop over their columns that LLVM vectorises (4 f64 or 8 f32 lanes per AVX2 instruction), with the same
         instructions for every pendulum, so frames stay byte-identical at any thread count. The events are
         found in a loop of their own, so that their branches leave the step's SIMD. A pendulum whose event is
-        in is stepped with its group but put back where its event left it, so it is no longer integrated: a
-        pair (a pixel and its twin) are neighbouring columns, and part together."""
+        in is stepped with its group but put back where its event left it, so it is no longer integrated. A
+        pixel and its twin are neighbouring columns, and stop together when they part."""
         sim = self.sim
         B = ti.static(self.sim.chunk)
         L = ti.static(self.lanes)

@@ -15,6 +15,7 @@ import textwrap
 import warnings
 
 import taichi as ti
+from taichi.lang import kernel_impl
 from taichi.lang.ast import ast_transformer_utils
 
 _current: tuple | None = None
@@ -56,6 +57,16 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, 
 
 def generation() -> int:
     return _generation
+
+
+def forget():
+    """Have the next init() start Taichi afresh, whatever runs now (the fields of earlier runs go with it).
+
+    Taichi's offline cache keys a kernel by the fields allocated before it in the process, so a kernel is
+    found there again only after the same history: tests/conftest.py starts each test module afresh, so
+    that its kernels are found whichever modules its worker ran before."""
+    global _current
+    _current = None
 
 
 @contextlib.contextmanager
@@ -151,3 +162,26 @@ class _RememberingWrapper:
 
 if ast_transformer_utils.TextWrapper is textwrap.TextWrapper:  # taichi 1.7.4 (pyproject.toml pins it)
     ast_transformer_utils.TextWrapper = _RememberingWrapper
+
+
+# The same front end reads each Taichi function's source afresh every time a kernel that calls it is compiled:
+# inspect.getsourcelines tokenizes the whole function again (and getsourcefile searches sys.modules), once per
+# call site per kernel instance. A source file does not change under a running process, so each function's
+# lines are read once; the front end copies them before it changes anything.
+_getsourcelines, _getsourcefile = kernel_impl.getsourcelines, kernel_impl.getsourcefile
+
+
+@functools.lru_cache(maxsize=None)
+def _source_lines(func) -> tuple[tuple[str, ...], int]:
+    lines, first = _getsourcelines(func)
+    return tuple(lines), first
+
+
+def _remembered_lines(func):
+    lines, first = _source_lines(func)
+    return list(lines), first
+
+
+if kernel_impl.getsourcelines.__module__ == "taichi.lang._wrap_inspect":  # taichi 1.7.4, as above
+    kernel_impl.getsourcelines = _remembered_lines
+    kernel_impl.getsourcefile = functools.lru_cache(maxsize=None)(_getsourcefile)
