@@ -248,8 +248,7 @@ class Map(runtime.Launcher):
                         lane = k * L
                         if on[lane]:
                             live = 1
-                            self.events(g * B + lane, Q0, V0, Q, V, lane, t0 + s * h, h)
-                            if self.event[self.point(g * B + lane)] != PENDING:
+                            if self.events(g * B + lane, Q0, V0, Q, V, lane, t0 + s * h, h):
                                 for j in ti.static(range(L)):
                                     on[lane + j] = 0
                         else:
@@ -266,7 +265,7 @@ class Map(runtime.Launcher):
     @ti.func
     def events(self, i, q, v, q1, v1, lane, t, h):
         """Pendulum i's event (column `lane`; with its twin at lane + 1) within the step from (q, v) at t to
-        (q1, v1) at t + h, at its interpolated time."""
+        (q1, v1) at t + h, recorded at its interpolated time; whether it happened."""
         frac = 2.0
         if ti.static(self.twins):
             d0, d1 = self.distance(q, v, lane), self.distance(q1, v1, lane)
@@ -279,6 +278,7 @@ class Map(runtime.Launcher):
                     frac = ti.min(frac, (math.pi - a) / (b - a))
         if frac <= 1.0:
             self.event[self.point(i)] = t + frac * h
+        return frac <= 1.0
 
     @ti.func
     def distance(self, q, v, lane):
