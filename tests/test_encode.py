@@ -77,6 +77,17 @@ def test_shrink_is_an_area_average(size):
     assert (gif.shrink(flat, w, h) == 200).all()  # a flat frame stays flat: the weights sum to one
 
 
+@pytest.mark.parametrize("n, m", [(720, 198), (144, 99), (1080, 198), (500, 499), (300, 7), (64, 64)])
+def test_the_rows_are_summed_cell_by_cell_as_reduceat_sums_them(n, m):
+    """shrink's first pass sums each cell of rows in whole-row passes, not with reduceat: the same integers,
+    the last cell running to the end where k[m] rounds down (500 rows into 499: 499.99999 -> 499)."""
+    frame = np.random.default_rng(n + m).integers(0, 256, (n, 40, 3), dtype=np.uint8)
+    k = np.floor(np.arange(m + 1) * (n / m)).astype(np.int64)
+    want = np.add.reduceat(frame, k[:-1], axis=0, dtype=np.int64)
+    got = gif._cell_sums(frame, k)
+    assert got.shape == want.shape and (got == want).all()
+
+
 def test_a_gif_frame_of_the_wrong_size_is_refused(tmp_path):
     v = video(20, 20, 96, 54, 48)
     enc = encode.Encoder(tmp_path, "x", v, 2, formats=["gif"])
