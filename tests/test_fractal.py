@@ -125,6 +125,32 @@ def test_a_map_steps_each_pendulum_as_the_systems_advance_until_its_event_and_th
     assert (q_map[done] != q_plain[done]).any(-1).mean() > 0.9  # stopped at its event, while the plain run went on
 
 
+@pytest.mark.parametrize("name, sets", [("fractal_flip", ["map.samples=4"]), ("fractal_divergence", [
+    "map.epsilon=1e-3"])])
+def test_an_event_map_repaints_only_what_changed_and_its_frames_are_those_painted_whole(name, sets):
+    """An event map keeps its plot between frames and repaints only the pixels still pending or settled since
+    the last paint: every frame, one after two advances included, is byte for byte the frame painted whole.
+    (A divergence map's pending pairs change their grey every frame; a flip map's settle for good: late in
+    it well under half of the plot still changes from frame to frame.)"""
+    import math
+    scene = load(name, ["video.width=96", "video.height=64", "video.duration=3", "video.fps=10",
+                        "integrator.min_faithful=0", *sets])
+    src = pipeline.Source(scene)
+    canvas, last, changed = src.canvas, None, []
+    for f in range(scene.frames):
+        if f == 12:
+            next(src._steps)  # a frame advanced but never drawn: what settled in it must still be repainted
+        frame = src.next_frame()
+        canvas.painted = -math.inf
+        assert canvas.draw().tobytes() == frame.tobytes(), f
+        if last is not None:
+            changed.append((frame != last).any(-1).mean())
+        last = frame
+        if src.index == scene.frames - 1:
+            break
+    assert max(changed) > 0 and (scene.fractal == "divergence" or max(changed[-5:]) < 0.5), changed
+
+
 # ---------------------------------------------------------------- flip times and the trust mask
 
 @pytest.mark.slow
