@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from render.commands import bench, cli, peers
+from render.commands import bench, bench_report, cli, peers
 from render.video import pipeline
 from render.config.scene import load
 
@@ -146,7 +146,7 @@ def test_interleaved_rounds_take_each_side_in_turn():
     assert r == {"value": pytest.approx(2.4), "min": 2.0, "max": 4.0, "spread_pct": pytest.approx(100 * 2 / 2.4),
                  "rounds": 3}
     assert peers.ratio([1.0], None) is None  # a peer that did not run
-    assert bench.spread_text(r) == "2..4 (83 %)" and bench.with_spread(r) == "**2.40** (2.00..4.00 (83 %))"
+    assert bench_report.spread_text(r) == "2..4 (83 %)" and bench_report.with_spread(r) == "**2.40** (2.00..4.00 (83 %))"
 
 
 def fake_results(numba=True):
@@ -183,8 +183,8 @@ def fake_results(numba=True):
 
 @pytest.mark.parametrize("kind", ["avx2", "avx512"])
 def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monkeypatch, kind):
-    monkeypatch.setattr(bench, "cpu_kind", lambda: kind)
-    rep = bench.summarise(fake_results(), True, 1.0)
+    monkeypatch.setattr(bench_report, "cpu_kind", lambda: kind)
+    rep = bench_report.summarise(fake_results(), True, 1.0, bench.QUICK["chaos_s"], [0.5] * 3)
     assert rep["machine"]["cpu_kind"] == kind and rep["rounds"] == 2
     assert rep["hud_ms_720p"] == rep["hud_ms_per_frame"] == 0.8
     assert rep["peak_gflops"] == {"f32": 90.0, "f64": 90.0} and rep["peak_flops_f64"] == 90e9
@@ -200,17 +200,17 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     f64 = t["rigid_f64_steps_per_s_1e5"]  # 5e7 steps/s: past AVX2's 3.5e7, short of AVX-512's 5.5e7
     assert f64["goal"] == f">= {goal}" and f64["met"] is met
     assert t["sim_speedup_vs_numpy_1e5"]["goal"] == f">= {speedup}" and t["sim_speedup_vs_numpy_1e5"]["met"]
-    md = bench.markdown(rep)
+    md = bench_report.markdown(rep)
     assert "| matplotlib_draw_ratio | 14.1 | 13.3..15 (12 %) |" in md and "**0.278** (0.250..0.300 (18 %))" in md
     assert f"{kind} targets" in md and "load average" in md
 
 
 def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):
-    rep = bench.summarise(fake_results(numba=False), True, 1.0)
+    rep = bench_report.summarise(fake_results(numba=False), True, 1.0, bench.QUICK["chaos_s"], [0.5] * 3)
     for key in PEER_KEYS:
         assert rep[key] is None and rep["spread"][key] is None
     assert rep["targets"]["sim_speedup_vs_numba_1e5"]["met"] is None
-    assert "null" in bench.markdown(rep)
+    assert "null" in bench_report.markdown(rep)
 
 
 def test_repeat_must_be_a_positive_count(capsys, tmp_path):

@@ -202,8 +202,8 @@ def csv_text(rows) -> str:
 
 def summary_md(rows, energy) -> str:
     """One row per system and method at the presets' dt in f64: docs/accuracy.md's table."""
-    lines = [f"| system | method | order | error at the case's horizon | ns per pendulum-step | energy error over "
-             f"1e5 steps, first third -> last third |", "|---|---|---:|---|---:|---|"]
+    lines = ["| system | method | order | error at the case's horizon | ns per pendulum-step | energy error over "
+             "1e5 steps, first third -> last third |", "|---|---|---:|---|---:|---|"]
     for r in rows:
         if r["precision"] != "f64" or r["dt"] != LONG_DT:
             continue

@@ -66,7 +66,7 @@ def read_json(path: Path):
     path = Path(path)
     try:  # O_NONBLOCK: opening a FIFO returns at once instead of waiting for a writer, and fstat then tells
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
-    except OSError as e:
+    except OSError:
         if os.path.islink(path):  # O_NOFOLLOW's ELOOP
             raise Refused(f"{path.name} is a symlink (to {_short(os.readlink(path))}), not a file") from None
         raise
