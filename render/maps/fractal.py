@@ -216,23 +216,32 @@ class Map(Painting, runtime.Launcher):
                 if kk < self.n_pending[None]:
                     for m in ti.static(range(L)):
                         on[k * L + m] = 1
+            near = ti.Vector.zero(float, P)  # divergence: each pair's distance at the start of the substep
+            if ti.static(self.twins):
+                for k in range(P):
+                    near[k] = self.distance(Q, V, k * L)
             for s in range(substeps):
                 Q0, V0 = Q, V
                 for lane in range(B):  # the loop LLVM vectorises
                     q, v = steps.step(sim, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
                     Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                far = near  # and at its end: once per substep (the next one starts from it), apart from the
+                if ti.static(self.twins):  # events' branches
+                    for k in range(P):
+                        far[k] = self.distance(Q, V, k * L)
                 live = 0
                 for k in range(P):  # a point: a pixel, or a pixel and its twin (columns lane, lane + 1)
                     lane = k * L
                     if on[lane]:
                         live = 1
                         j = self.pending[g * P + k]
-                        if self.events(j, Q0, V0, Q, V, lane, t0 + s * h, h):
+                        if self.events(j, Q0, Q, lane, near[k], far[k], t0 + s * h, h):
                             for m in ti.static(range(L)):
                                 on[lane + m] = 0
                     else:
                         for m in ti.static(range(L)):
                             Q[:, lane + m], V[:, lane + m] = Q0[:, lane + m], V0[:, lane + m]
+                near = far
                 if not live:
                     break
             for k in range(P):
@@ -245,12 +254,11 @@ class Map(Painting, runtime.Launcher):
                         sim.watch(i, Q[:, k * L + m], V[:, k * L + m])
 
     @ti.func
-    def events(self, j, q, v, q1, v1, lane, t, h):
-        """Point j's event (column `lane`; with its twin at lane + 1) within the step from (q, v) at t to
-        (q1, v1) at t + h, recorded at its interpolated time; whether it happened."""
+    def events(self, j, q, q1, lane, d0, d1, t, h):
+        """Point j's event (column `lane`) within the step from angles q at t to q1 at t + h (a divergence
+        map's: its pair's distances d0 to d1), recorded at its interpolated time; whether it happened."""
         frac = 2.0
         if ti.static(self.twins):
-            d0, d1 = self.distance(q, v, lane), self.distance(q1, v1, lane)
             if d1 > self.threshold:
                 frac = ti.max(0.0, (self.threshold - d0) / (d1 - d0))
         else:
