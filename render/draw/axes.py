@@ -1,6 +1,6 @@
 """What a map's frame shows around its plot, and where: a title row, axes with ticks and labels (θ in units of
 π where the range is a simple multiple of π, else decimals with as many digits as the tick step needs, with
-the unit), a colour bar with its unit and a legend. Plain Python: it lays out, render/maps/fractal.py draws (the text
+the unit), a colour bar with its unit and a legend. Plain Python: it lays out, render/maps/paint.py draws (the text
 with the bundled font, the bars and swatches with the same colour functions as the plot).
 
 Everything here is static for a render, so the map draws it once into a background that each frame copies;

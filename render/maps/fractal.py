@@ -185,8 +185,8 @@ class Map(Painting, runtime.Launcher):
         """Every point with an event ahead, `substeps` steps of h on, recording events as they happen.
 
         The points still pending are listed first, in order, and stepped in groups of `chunk` pendulums from
-        that list: late in a flip map 7 % of the points are pending, but they are spread over a third of the
-        map's fixed groups of neighbours, which stepped 3.4 times the pendulums that needed it. A group is
+        that list: at the end of the 20 s flip map 7 % of the points are pending, but they are spread over a
+        quarter of the map's fixed groups of neighbours, which stepped 3.5 times the pendulums that needed it. A group is
         stepped as System.advance steps it: its state in local D × chunk matrices, each substep a loop over
         their columns that LLVM vectorises, with the same instructions for every column, so that no pendulum's
         bits depend on the column or the group it is stepped in (frames stay byte-identical at any thread

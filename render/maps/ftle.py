@@ -29,7 +29,7 @@ away from the top, and σ is still measured there, not blacked out (it is mostly
 The trust mask is the other maps': every pixel claims its trajectory up to t, and is desaturated and
 hatched past the faithful time of its lattice neighbours. With map.samples = 4 or 9 each sample (point) carries
 its own tangent vectors and σ, the barrier's curve is found on the samples' own finer grid (a sample on it is
-black), and a pixel shows its samples' colours averaged as render/maps/fractal.py's map does.
+black), and a pixel shows its samples' colours averaged as render/maps/paint.py paints every map.
 
 **Trig.** Taichi's forward mode cannot differentiate render/physics/sincos.py's inline sin/cos, so the tangent
 kernel steps a libm twin of the system (tangent.libm_twin) and its primal is the map's state. The preset
