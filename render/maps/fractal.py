@@ -186,11 +186,11 @@ class Map(Painting, runtime.Launcher):
 
         The points still pending are listed first, in order, and stepped in groups of `chunk` pendulums from
         that list: at the end of the 20 s flip map 7 % of the points are pending, but they are spread over a
-        quarter of the map's fixed groups of neighbours, which stepped 3.5 times the pendulums that needed it. A group is
-        stepped as System.advance steps it: its state in local D × chunk matrices, each substep a loop over
-        their columns that LLVM vectorises, with the same instructions for every column, so that no pendulum's
-        bits depend on the column or the group it is stepped in (frames stay byte-identical at any thread
-        count). The events are found in a loop of their own, so that their branches leave the step's SIMD. A
+        quarter of the map's fixed groups of neighbours, which stepped 3.5 times the pendulums that needed it.
+        A group is stepped as System.advance steps it: its state in local D × chunk matrices, each substep a
+        loop over their columns that LLVM vectorises, with the same instructions for every column, so that no
+        pendulum's bits depend on the column or the group it is stepped in (frames stay byte-identical at any
+        thread count). The events are found in a loop of their own, so that their branches leave the step's SIMD. A
         pendulum whose event is in is stepped on with its group but put back where its event left it, and the
         group stops as soon as all of its events are in. A pixel and its twin are neighbouring columns, and
         stop together when they part."""

@@ -77,9 +77,10 @@ def _average(a: np.ndarray, m: int) -> np.ndarray:
 def _cell_sums(a: np.ndarray, k: np.ndarray) -> np.ndarray:
     """The sums of a's cells a[k[i]:k[i + 1]], the last one to the end of a whatever k[m] rounded to, as
     np.add.reduceat gives them. A frame's bytes are summed in whole-row passes, the j-th row of every cell at
-    once, exact in int32 (255 · rows): reduceat steps through each cell of each column on its own, 14 ms of
-    a 720p frame's 17, which was 60 % of a map's GIF frame. Floats (the second pass, over columns) stay with
-    reduceat, whose order of additions the bytes depend on, and which is fast there."""
+    once, exact in int32 (255 · rows): reduceat steps through each cell of each column on its own, and took
+    14 ms of the 17 ms in which a 720p frame was shrunk to 352 × 198 (this way: 8.7 ms in all). Floats (the
+    second pass, over columns) stay with reduceat, whose order of additions the bytes depend on, and which
+    is fast there."""
     start = k[:-1]
     if a.dtype.kind not in "ui":
         return np.add.reduceat(a, start, axis=0)
