@@ -198,6 +198,7 @@ class Map(Painting, runtime.Launcher):
         B = ti.static(self.sim.chunk)
         L = ti.static(self.lanes)
         P = ti.static(self.per_group)
+        S = ti.static(runtime.SPREAD)
         n = 0
         ti.loop_config(serialize=True)  # the list in point order: a cheap pass next to the stepping
         for j in range(self.points):
@@ -205,53 +206,55 @@ class Map(Painting, runtime.Launcher):
                 self.pending[n] = j
                 n += 1
         self.n_pending[None] = n
-        for g in range((self.n_pending[None] + P - 1) // P):
-            on = ti.Vector.zero(ti.i32, B)  # 1 while the column's event is ahead: it is stepped on
-            Q, V = ti.Matrix.zero(float, sim.D, B), ti.Matrix.zero(float, sim.D, B)
-            for k in range(P):  # a column past the list's end steps a copy of its last point, and is not kept
-                kk = g * P + k
-                j = self.pending[ti.min(kk, self.n_pending[None] - 1)]
-                for m in ti.static(range(L)):
-                    Q[:, k * L + m], V[:, k * L + m] = sim.q[j * L + m], sim.v[j * L + m]
-                if kk < self.n_pending[None]:
+        for t in range((self.n_pending[None] + P - 1) // P * S):  # see runtime.SPREAD
+            if t % S == 0:
+                g = t // S
+                on = ti.Vector.zero(ti.i32, B)  # 1 while the column's event is ahead: it is stepped on
+                Q, V = ti.Matrix.zero(float, sim.D, B), ti.Matrix.zero(float, sim.D, B)
+                for k in range(P):  # a column past the list's end steps a copy of its last point, and is not kept
+                    kk = g * P + k
+                    j = self.pending[ti.min(kk, self.n_pending[None] - 1)]
                     for m in ti.static(range(L)):
-                        on[k * L + m] = 1
-            near = ti.Vector.zero(float, P)  # divergence: each pair's distance at the start of the substep
-            if ti.static(self.twins):
-                for k in range(P):
-                    near[k] = self.distance(Q, V, k * L)
-            for s in range(substeps):
-                Q0, V0 = Q, V
-                for lane in range(B):  # the loop LLVM vectorises
-                    q, v = steps.step(sim, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
-                    Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
-                far = near  # and at its end: once per substep (the next one starts from it), apart from the
-                if ti.static(self.twins):  # events' branches
-                    for k in range(P):
-                        far[k] = self.distance(Q, V, k * L)
-                live = 0
-                for k in range(P):  # a point: a pixel, or a pixel and its twin (columns lane, lane + 1)
-                    lane = k * L
-                    if on[lane]:
-                        live = 1
-                        j = self.pending[g * P + k]
-                        if self.events(j, Q0, Q, lane, near[k], far[k], t0 + s * h, h):
-                            for m in ti.static(range(L)):
-                                on[lane + m] = 0
-                    else:
+                        Q[:, k * L + m], V[:, k * L + m] = sim.q[j * L + m], sim.v[j * L + m]
+                    if kk < self.n_pending[None]:
                         for m in ti.static(range(L)):
-                            Q[:, lane + m], V[:, lane + m] = Q0[:, lane + m], V0[:, lane + m]
-                near = far
-                if not live:
-                    break
-            for k in range(P):
-                kk = g * P + k
-                if kk < self.n_pending[None]:
-                    j = self.pending[kk]
-                    for m in ti.static(range(L)):
-                        i = j * L + m
-                        sim.q[i], sim.v[i] = Q[:, k * L + m], V[:, k * L + m]
-                        sim.watch(i, Q[:, k * L + m], V[:, k * L + m])
+                            on[k * L + m] = 1
+                near = ti.Vector.zero(float, P)  # divergence: each pair's distance at the start of the substep
+                if ti.static(self.twins):
+                    for k in range(P):
+                        near[k] = self.distance(Q, V, k * L)
+                for s in range(substeps):
+                    Q0, V0 = Q, V
+                    for lane in range(B):  # the loop LLVM vectorises
+                        q, v = steps.step(sim, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                        Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                    far = near  # and at its end: once per substep (the next one starts from it), apart from the
+                    if ti.static(self.twins):  # events' branches
+                        for k in range(P):
+                            far[k] = self.distance(Q, V, k * L)
+                    live = 0
+                    for k in range(P):  # a point: a pixel, or a pixel and its twin (columns lane, lane + 1)
+                        lane = k * L
+                        if on[lane]:
+                            live = 1
+                            j = self.pending[g * P + k]
+                            if self.events(j, Q0, Q, lane, near[k], far[k], t0 + s * h, h):
+                                for m in ti.static(range(L)):
+                                    on[lane + m] = 0
+                        else:
+                            for m in ti.static(range(L)):
+                                Q[:, lane + m], V[:, lane + m] = Q0[:, lane + m], V0[:, lane + m]
+                    near = far
+                    if not live:
+                        break
+                for k in range(P):
+                    kk = g * P + k
+                    if kk < self.n_pending[None]:
+                        j = self.pending[kk]
+                        for m in ti.static(range(L)):
+                            i = j * L + m
+                            sim.q[i], sim.v[i] = Q[:, k * L + m], V[:, k * L + m]
+                            sim.watch(i, Q[:, k * L + m], V[:, k * L + m])
 
     @ti.func
     def events(self, j, q, q1, lane, d0, d1, t, h):

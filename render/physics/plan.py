@@ -8,11 +8,19 @@ no field. The system's Taichi side (render/physics/kernels/, on system.System) i
 built (stepper.Run), so listing presets, validating a scene and planning its step import no Taichi
 (tests/test_start.py).
 """
+import dataclasses
 import math
 
 import numpy as np
 
 from . import grid, integrators, keys, poincare
+
+
+# Planning a map is not free: a 720p map's 381,924 starts and the bound on their fastest rate take 0.23 s. A
+# map's certificate plans its scene three times and its shadow's twice (its own step, then each Run's plan and
+# system), and the render once more; so this process keeps the last plans, by the scene less its name.
+_PLANNED: dict = {}
+PLANNED_SIZE = 8
 
 
 class Plan:
@@ -52,12 +60,17 @@ class Plan:
         self.method = scene.integrator.method
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
-        q0, v0 = self.initial_state()
-        self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
-                                                     self.energy_limit(q0, v0, self.method))
+        key = repr(dataclasses.replace(scene, name="", description="", budget=None))
+        if key not in _PLANNED:
+            q0, v0 = self.initial_state()
+            _PLANNED[key] = q0, v0, integrators.timestep(scene, self.omega_max(q0, v0),
+                                                         self.energy_limit(q0, v0, self.method))
+            while len(_PLANNED) > PLANNED_SIZE:
+                del _PLANNED[next(iter(_PLANNED))]
+        q0, v0, (self.h, self.substeps) = _PLANNED[key]
         integrators.check_substeps(scene, self.substeps, self.h)  # "auto" is known only now: before any work
-        if subset is not None:
-            q0, v0 = q0[subset], v0[subset]
+        q0, v0 = (q0, v0) if subset is None else (q0[subset], v0[subset])
+        q0, v0 = q0.copy(), v0.copy()  # the planned start stays as it was
         self.n, self.subset = len(q0), subset
         return q0, v0
 

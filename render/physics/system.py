@@ -147,32 +147,35 @@ class System(Plan, runtime.Launcher):
         pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
         at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
         B = ti.static(self.chunk)
-        for g in range(self.groups):
-            Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
-            for lane in range(B):
-                i = ti.min(g * B + lane, self.n - 1)
-                Q[:, lane], V[:, lane] = self.q[i], self.v[i]
-            Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
-            if ti.static(self.poincare):
+        S = ti.static(runtime.SPREAD)
+        for t in range(self.groups * S):  # blocks of 4 groups for the threads, not 512 (runtime.SPREAD)
+            if t % S == 0:
+                g = t // S
+                Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
                 for lane in range(B):
-                    if g * B + lane < self.n:
-                        self.crossed[g * B + lane] = 0
-            for s in range(substeps):
+                    i = ti.min(g * B + lane, self.n - 1)
+                    Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+                Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
                 if ti.static(self.poincare):
-                    Q0, V0 = Q, V
-                for lane in range(B):  # the loop LLVM vectorises
-                    q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
-                    Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
-                if ti.static(self.poincare):  # in a loop of its own, so that its branch leaves the step's SIMD
                     for lane in range(B):
-                        crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
-                                        ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
-                                        ti.Matrix.cols([V[:, lane]]), h)
-            for lane in range(B):
-                i = g * B + lane
-                if i < self.n:
-                    self.q[i], self.v[i] = Q[:, lane], V[:, lane]
-                    self.watch(i, Q[:, lane], V[:, lane])
+                        if g * B + lane < self.n:
+                            self.crossed[g * B + lane] = 0
+                for s in range(substeps):
+                    if ti.static(self.poincare):
+                        Q0, V0 = Q, V
+                    for lane in range(B):  # the loop LLVM vectorises
+                        q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                        Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                    if ti.static(self.poincare):  # a loop of its own: its branch leaves the step's SIMD
+                        for lane in range(B):
+                            crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                                             ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
+                                             ti.Matrix.cols([V[:, lane]]), h)
+                for lane in range(B):
+                    i = g * B + lane
+                    if i < self.n:
+                        self.q[i], self.v[i] = Q[:, lane], V[:, lane]
+                        self.watch(i, Q[:, lane], V[:, lane])
 
     @ti.kernel
     def advance_libm(self, substeps: ti.i32, h: float):
