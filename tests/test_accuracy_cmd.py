@@ -7,7 +7,7 @@ import numpy as np
 from conftest import run_cli
 from render.physics import registry
 from render.commands.accuracy import COLUMNS
-from render.config.scene import METHODS
+from render.config.limits import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 PNGS = (*(f"{chart}_{s}.png" for s in registry.names() for chart in ("work_precision", "energy_drift")),

@@ -180,8 +180,9 @@ def no_pipeline(monkeypatch):
         seen.append((scene, kwargs))
         raise Ran()
 
-    monkeypatch.setattr(render.commands.api.pipeline, "render", stand_in)
-    monkeypatch.setattr(render.commands.api.pipeline, "simulate", stand_in)
+    # named by path, so the API module is imported here even when no earlier test in this worker loaded it
+    monkeypatch.setattr("render.commands.api.pipeline.render", stand_in)
+    monkeypatch.setattr("render.commands.api.pipeline.simulate", stand_in)
     return seen
 
 

@@ -28,7 +28,8 @@ from render.config import budget, estimate
 from render.video import pipeline
 from render.physics import registry, runtime
 from render.errors import SceneError
-from render.config.scene import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SCHEMA, SYSTEMS
+from render.config.limits import EFFECTS, FORMATS, LAYOUTS, METHODS, PRECISIONS, SYSTEMS
+from render.config.scene import SCHEMA
 
 BASE = {"system": SYSTEMS[0], "pendulums": {"count": 2, "theta1": 2.0, "theta2": 2.5},
         "video": {"width": 16, "height": 16, "fps": 10, "duration": 0.2, "gif_width": 16}}

@@ -10,7 +10,7 @@ import pytest
 from render.commands import accuracy
 from render.physics import integrators, reference, registry
 from render.physics.stepper import Run
-from render.config.scene import METHODS
+from render.config.limits import METHODS
 
 THEORY = {"symplectic_euler": 1, "verlet": 2, "rk2": 2, "implicit_midpoint": 2, "rk4": 4, "yoshida4": 4}
 # In the asymptotic regime for every method, and above the reference's ~1e-12 error even for rk4.

@@ -9,7 +9,8 @@ from render.commands import cli
 from render.physics import integrators, reference, registry
 from render.physics.plan import Plan
 from render.physics.system import System
-from render.config.scene import EFFECTS, LINK_EFFECTS, load
+from render.config.limits import EFFECTS, LINK_EFFECTS
+from render.config.scene import load
 
 PKG = Path(__file__).resolve().parent.parent / "render"
 SYSTEM_DIR = PKG / "physics" / "systems"

@@ -21,7 +21,8 @@ from ..physics import reference, registry
 from ..physics.stepper import Run
 from ..video.atomic import write_atomic
 from ..config.options import check_writable
-from ..config.scene import METHODS, PRECISIONS, load
+from ..config.limits import METHODS, PRECISIONS
+from ..config.scene import load
 
 COLUMNS = ("system", "method", "precision", "dt", "traj_error", "energy_drift", "ns_per_step", "order")
 FPS = 10  # frames of 0.1 s: every dt in the ladders divides it exactly, so the step is exactly dt

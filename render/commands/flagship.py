@@ -16,7 +16,8 @@ from ..trust import certify
 from ..physics import reference
 from ..video.pipeline import simulate
 from ..trust.quality import LEVELS, TARGET
-from ..config.scene import METHODS, load
+from ..config.limits import METHODS
+from ..config.scene import load
 
 FLAGSHIP = "rigid_chaos"
 FPS = 30  # frames compared with the reference

@@ -28,7 +28,7 @@ from ..trust import faithful
 from ..video import poster
 from ..video.atomic import digest, write_atomic
 from ..errors import SceneError
-from ..config.validate import DESCRIPTION_MAX
+from ..config.limits import DESCRIPTION_MAX
 from ..video.version import __version__
 
 CSS = """

@@ -17,7 +17,7 @@ import stat
 from pathlib import Path
 
 from ..errors import SceneError
-from .validate import hint
+from .checks import hint
 
 ENV = "PENDULUM_PRESETS"
 

@@ -92,8 +92,8 @@ def add_name(p):
 
 
 def folder_name(text: str) -> str:
-    """An argparse type: a name a scene may have (validate.py), so it is safe as a folder and file name."""
-    from .validate import NAME_MAX, NAME_PATTERN
+    """An argparse type: a name a scene may have (limits.py), so it is safe as a folder and file name."""
+    from .limits import NAME_MAX, NAME_PATTERN
 
     if not re.fullmatch(NAME_PATTERN, text) or len(text) > NAME_MAX:
         raise argparse.ArgumentTypeError(f"must be letters, digits, _ . - (not first . or -), at most {NAME_MAX} "
@@ -108,7 +108,7 @@ def output_name(scene, overridden: bool, name: str | None = None):
     """The scene under the name of the folder it renders to. OUT/NAME/ is only ever the preset as written:
     with overrides (--set, --quality) the folder is NAME__<short hash of the resolved scene>, the same for
     the same result however the overrides were spelled, unless --name gives it a name."""
-    from .validate import NAME_MAX
+    from .limits import NAME_MAX
 
     if name is not None:
         if overridden and name == scene.name:
@@ -136,7 +136,7 @@ def thread_count(text: str) -> int:
 
 def check_arch(arch) -> str:
     """The API's arch=: what --arch accepts (SceneError otherwise)."""
-    from .validate import clip
+    from .checks import clip
 
     if not isinstance(arch, str) or arch not in ARCHES:
         raise SceneError(f"arch={clip(repr(arch))}: must be one of {', '.join(ARCHES)}")
@@ -150,7 +150,7 @@ def usable_cores() -> int:
 
 def check_tiles(tiles) -> int | None:
     """The API's tiles=: None or what --tiles accepts (SceneError otherwise)."""
-    from .validate import clip
+    from .checks import clip
 
     if tiles is None:
         return None
@@ -161,7 +161,7 @@ def check_tiles(tiles) -> int | None:
 
 def check_threads(threads) -> int | None:
     """The API's threads=: None (all cores) or what --threads accepts (SceneError otherwise)."""
-    from .validate import clip
+    from .checks import clip
 
     if threads is None:
         return None

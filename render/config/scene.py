@@ -16,8 +16,9 @@ from ..physics import keys, registry
 from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
 from ..errors import SceneError
 from ..trust.levels import check_level
-from .validate import (EFFECTS, FORMATS, FRACTALS, LAYOUTS, LINK_EFFECTS, MAP_AXES, MAP_DEFAULTS, MAX_PENDULUMS,  # noqa: F401
-                       MAX_PIXELS, METHODS, PRECISIONS, REQUIRED, SYSTEMS, Validator, clip, hint)
+from .checks import clip, hint
+from .limits import MAP_AXES, MAP_DEFAULTS, REQUIRED, SYSTEMS
+from .validate import Validator
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
 # `gap` (the angle between neighbours) is another way to give the fan: it resolves to spread = gap·count.
@@ -44,7 +45,7 @@ SCHEMA: dict[str, object] = {
     "effects": None,
     "quality": None,  # a level of render/trust/quality.py: the integrator is then chosen by pilot runs
     "budget": None,  # seconds (or "2h") a run may be estimated to take, beyond budget.DEFAULT_LIMIT_S
-    "fractal": None,  # a map's colouring (FRACTALS); "angles" when effects list "fractal" and this is not given
+    "fractal": None,  # a map's colouring (limits.FRACTALS); "angles" when effects list "fractal" and this is not given
     "compare": None,  # a comparison: [compare] vary = { KEY = [V1, V2, ...] } (validate.py, split.py)
     "pendulums": pendulum_keys(None),
     "integrator": {

@@ -1,163 +1,31 @@
 """Validation of a preset's values: every key typed and within its physical range, or one SceneError line.
 
 Kept apart from the loader (scene.py) so each reads as one idea: scene.py says what a preset is and how it
-is read; this module says which values are accepted and why. A number is accepted only where f64 (and f32
-for drafts) arithmetic on it is still meaningful: finite, positive where the physics needs it, and inside
-the ranges below (systems declare theirs in render/physics/keys.py). What a valid scene *costs* is render/config/budget.py.
+is read; this module says which values each section accepts and why. The choices and ranges are
+render/config/limits.py (systems declare theirs in render/physics/keys.py), the typed checks of one value
+render/config/checks.py; what a valid scene *costs* is render/config/budget.py.
 
 Validator.build returns plain, validated sections; scene.from_dict turns them into the frozen Scene.
 """
 from __future__ import annotations
 
-import difflib
 import json
-import math
 import re
 from types import SimpleNamespace  # the validated [map] read as grid.py reads a MapSpec
 
 from ..physics import grid, keys, registry
-from ..errors import SceneError
 from ..trust.levels import LEVELS
+from .checks import Checker, clip, hint, show_key, tname
+from .limits import (AXIS_MAX, DAMPING_MAX, DESCRIPTION_MAX, EFFECTS, F32_SIZE_MAX, F32_SIZE_MIN, FORMATS, FRACTALS,
+                     GRAVITY_MAX, LAYOUTS, LINK_EFFECTS, MAP_AXES, MAP_DEFAULTS, MAX_MAP_PENDULUMS, MAX_PENDULUMS,
+                     MAX_PIXELS, METHODS, NAME_MAX, NAME_PATTERN, PALETTES, PRECISIONS, SAMPLES, SPREAD_MAX, SYSTEMS,
+                     TRIGS)
 from .vary import PANEL_MIN, VARIANTS, VARYING, Twice, dotted, frozen, plain, vary_refusal
 
-SYSTEMS = registry.names()
-METHODS = {name: registry.get(name).METHODS for name in SYSTEMS}
-PRECISIONS = ("f32", "f64")
-TRIGS = ("inline", "libm")  # integrator.trig: render/physics/sincos.py, or the C library's (bit for bit as the seed)
-FORMATS = ("mp4", "gif", "png")  # png: the last frame as a still
-LAYOUTS = ("fan", "grid", "shell")  # shell: on one energy shell, on the Poincaré section (render/physics/poincare.py)
-FRACTALS = ("angles", "flip_time", "divergence", "lyapunov")  # how a map (effects = ["fractal"]) colours its pixels
-MAP_DEFAULTS = {  # [map]: fractal maps only
-    "epsilon": 1e-6,  # rad: how far a divergence map's twin starts from its pixel, on the last link
-    "threshold": 0.1,  # a pair has diverged when its distance in (θ, ω) passes this
-    "trust_stride": 16,  # pixels between the lattice points the trust mask is certified on
-    "samples": 1,  # sub-pixel starts per pixel (render/physics/grid.py's sample_starts)
-}
-SAMPLES = (1, 4, 9)  # map.samples: a pixel's centre, or a regular 2 x 2 or 3 x 3 split of it
-MAP_AXES = {"x": grid.AXES[0], "y": grid.AXES[1], "x_range": list(grid.RANGE), "y_range": list(grid.RANGE)}
-AXIS_MAX = 1e4  # rad or rad/s: beyond it an angle has wrapped thousands of times and a rate needs µs steps
-# What a scene can call for. Drawn effects need a canvas; the rest change the simulation or bookkeeping.
-# New effects go at the end: the canonical order (the scene's hash) of existing scenes stays as it was.
-EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", "hud", "glow", "poincare", "lyapunov",
-           "audio")  # audio: a stereo track in the MP4 (render/video/audio.py)
-PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/draw/canvas.py)
-LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
-MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
-# A map's pendulums hold no trails and no HUD: a 3840x2160 flip map (a 2058² plot) is 4.2 M, an 8K one 16.9 M,
-# about 0.6 GB of f32 state and event fields (and a tiled render splits them over its workers)
-MAX_MAP_PENDULUMS = 20_000_000
-MAX_PIXELS = 3840 * 2160
-# The name becomes a folder and the files NAME.mp4 and .NAME.mp4.<owner>.<random>.part beside it; 100
-# characters keep every one of them far below the 255-byte limit of common file systems.
-NAME_MAX = 100
-NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.\-]*"  # letters, digits, _ . -, not starting with . or -
-DESCRIPTION_MAX = 1000  # free text shown in the gallery; longer is almost surely a mistake (a pasted file)
-# Common [pendulums] keys (each system declares its own in keys.py). Angles wrap, so beyond ±1000 rad a
-# spread only loses resolution (f64 resolves ~1e-13 rad there); gravity up to 1e4 m/s² (1000 g) and
-# damping up to 1e3 1/s (a swing stopped within milliseconds) already need steps of microseconds.
-SPREAD_MAX = 1e3
-GRAVITY_MAX = 1e4
-DAMPING_MAX = 1e3
-# f32 (drafts) spans 1e-38..3e38: the triple pendulum's mass-matrix determinant grows like (m·l²)³, so
-# lengths and masses of 1e6 overflow it and 1e-6 underflow it (NaN at the first frame). Within [1e-3, 1e3]
-# every system's f32 arithmetic stays in range.
-F32_SIZE_MIN, F32_SIZE_MAX = 1e-3, 1e3
 
-REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+class Validator(Checker):
+    """The sections' rules, each written with Checker's typed checks."""
 
-
-
-class Validator:
-    def __init__(self, src: str, given: dict):
-        self.src = src
-        self.given = given  # the keys as written, before defaults
-
-    def fail(self, key: str, msg: str):
-        raise SceneError(f"{self.src}: {key}: {msg}")
-
-    def merge(self, raw: dict, schema: dict, prefix: str) -> dict:
-        out = {}
-        for k, val in raw.items():
-            key = prefix + k
-            if k not in schema:
-                owners = [n for n in SYSTEMS if prefix == "pendulums." and k in registry.get(n).preset_keys()]
-                if owners:
-                    self.fail(key, f"is not a key of this system (it belongs to system {' and '.join(owners)})")
-                self.fail(show_key(key), "unknown key" + hint(k, list(schema), prefix))
-            if isinstance(schema[k], dict):
-                if not isinstance(val, dict):
-                    self.fail(key, f"must be a table, got {tname(val)}")
-                out[k] = self.merge(val, schema[k], key + ".")
-            else:
-                out[k] = val
-        for k, default in schema.items():
-            if k in out:
-                continue
-            if default is REQUIRED:
-                self.fail(prefix + k, "missing (this key is required)")
-            out[k] = self.merge({}, default, prefix + k + ".") if isinstance(default, dict) else default
-        return out
-
-    # typed getters ------------------------------------------------
-    def real(self, d, sec, key, lo=-math.inf, hi=math.inf, lo_open=False):
-        val, name = d[sec][key], f"{sec}.{key}"
-        if isinstance(val, bool) or not isinstance(val, (int, float)):
-            self.fail(name, f"must be a number, got {tname(val)}")
-        try:
-            val = float(val)
-        except OverflowError:  # a TOML integer of hundreds of digits
-            self.fail(name, f"must be finite, got an integer of {len(str(abs(val)))} digits")
-        if not math.isfinite(val):
-            self.fail(name, f"must be finite, got {val}")
-        if val < lo or (lo_open and val == lo) or val > hi:
-            self.fail(name, f"must be {describe_range(lo, hi, lo_open)}, got {val:g}")
-        return val
-
-    def integer(self, d, sec, key, lo, hi):
-        val, name = d[sec][key], f"{sec}.{key}"
-        if isinstance(val, bool) or not isinstance(val, int):
-            self.fail(name, f"must be an integer, got {tname(val)}")
-        if not lo <= val <= hi:
-            self.fail(name, f"must be between {lo} and {hi}, got {clip(str(val))}")
-        return val
-
-    def choice(self, val, name, options):
-        if not isinstance(val, str):
-            self.fail(name, f"must be a string, got {tname(val)}")
-        if val not in options:
-            self.fail(name, f"unknown value {clip(repr(val))}{hint(val, list(options))}; choose from "
-                      f"{', '.join(options)}")
-        return val
-
-    def reals(self, d, sec, key, n, lo=-math.inf, hi=math.inf, lo_open=False):
-        val, name = d[sec][key], f"{sec}.{key}"
-        if not isinstance(val, list) or len(val) != n:
-            self.fail(name, f"must be a list of {_COUNT.get(n, n)} numbers, got {clip(repr(val))}")
-        sub = {sec: {f"{key}[{i}]": x for i, x in enumerate(val)}}
-        return tuple(self.real(sub, sec, f"{key}[{i}]", lo, hi, lo_open) for i in range(n))
-
-    def declared(self, d, sec, key, spec):
-        """A value of a key a system declared (render/physics/keys.py)."""
-        if isinstance(spec, keys.Reals):
-            return self.reals(d, sec, key, len(spec.default), spec.lo, spec.hi, spec.lo_open)
-        return self.real(d, sec, key, spec.lo, spec.hi, spec.lo_open)
-
-    def strings(self, val, name, options):
-        if not isinstance(val, list) or not val:
-            self.fail(name, f"must be a non-empty list of strings, got {clip(repr(val))}")
-        out = tuple(self.choice(x, name, options) for x in val)
-        if len(set(out)) != len(out):
-            self.fail(name, f"lists an entry twice: {list(out)}")
-        return out
-
-    def text(self, val, name, limit):
-        if not isinstance(val, str):
-            self.fail(name, f"must be a string, got {tname(val)}")
-        if len(val) > limit:
-            self.fail(name, f"is longer than the limit of {limit} characters ({len(val)})")
-        return val
-
-    # sections -----------------------------------------------------
     def build(self, d: dict) -> dict:
         """The validated sections: name, description, system, effects, pendulums, integrator, video."""
         name = self.text(d["name"], "name", NAME_MAX)
@@ -387,7 +255,6 @@ class Validator:
             self.fail("effects", f"'glow' adds up the light of what is drawn and nothing is: list one of {list(keys.DRAWN)}")
         return tuple(e for e in EFFECTS if e in eff)  # canonical order: same scene, same hash
 
-
     def compare(self, d, pend, video, fractal) -> tuple | None:
         """[compare] vary = { KEY = [V1, V2, ...], ... }: ((key, values), ...), the keys paired (value i of
         each makes panel i). Each value is validated when the variants are built (Scene.variants)."""
@@ -439,41 +306,3 @@ class Validator:
             if size // parts < PANEL_MIN:
                 self.fail(f"video.{key}", f"{size} px split into {parts} panels leaves less than {PANEL_MIN} px each")
         return tuple(out)
-
-
-_COUNT = {1: "one", 2: "two", 3: "three", 4: "four"}
-
-
-def describe_range(lo: float, hi: float, lo_open: bool) -> str:
-    """How an accepted range reads in a message: '> 0 and <= 1', '>= 0', '> 0 and within [1e-06, 1e+06]'.
-
-    A range whose floor is above zero is a physically positive quantity, so it leads with '> 0'."""
-    upper = f" and <= {hi:g}" if hi < math.inf else ""
-    if lo == 0:
-        return (">" if lo_open else ">=") + " 0" + upper
-    if lo > 0:
-        return f"> 0 and within [{lo:g}, {hi:g}]"
-    if lo > -math.inf:
-        return f"within [{lo:g}, {hi:g}]"
-    return f"<= {hi:g}" if hi < math.inf else "a number"
-
-
-def hint(word: str, options: list[str], prefix: str = "") -> str:
-    close = difflib.get_close_matches(word, options, n=1)
-    return f" (did you mean '{prefix}{close[0]}'?)" if close else ""
-
-
-def clip(text: str, limit: int = 80) -> str:
-    """A user's value as shown in a one-line message: long values are cut, not printed whole."""
-    return text if len(text) <= limit else text[:limit - 3] + "..."
-
-
-def show_key(key: str) -> str:
-    """A key as written (TOML quoted keys may hold anything), quoted where it is not a plain dotted name."""
-    return key if re.fullmatch(r"[\w.\-]*", key) else clip(repr(key))
-
-
-def tname(val) -> str:
-    return {bool: "a boolean", str: "a string", list: "a list", dict: "a table", int: "an integer",
-            float: "a number"}.get(type(val), type(val).__name__) + (
-        f" {clip(repr(val))}" if not isinstance(val, dict) else "")
