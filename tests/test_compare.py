@@ -13,7 +13,7 @@ import pytest
 
 from conftest import ROOT
 from render.commands import batch, cli
-from render.draw import hud, split
+from render.draw import hud_text, split
 from render.video import pipeline
 from render.draw.font import Font, text_height, text_width
 from render.config.options import output_name
@@ -178,7 +178,7 @@ def clock_colours(src, frames, i) -> list[str]:
     h = src.panels[i].canvas.hud
     width, height = text_width("t = 99.99 s", h.bs, h.big), text_height("t", h.bs, h.big)
     right, bottom = x0 + h.w - h.m, y0 + h.h - h.m
-    names = {"white": hud.WHITE, "amber": hud.AMBER, "red": hud.RED}
+    names = {"white": hud_text.WHITE, "amber": hud_text.AMBER, "red": hud_text.RED}
     out = []
     for frame in frames:
         box = frame[bottom - height:bottom, right - width:right].astype(int)

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from render.draw import hud
+from render.draw import hud, hud_text
 from render.physics.stepper import Run
 from render.config.scene import load
 
@@ -49,9 +49,9 @@ def tip_positions(name, q):
 def test_every_system_gets_a_clock_and_its_fans_spread(name):
     canvas, frames, sim = run(name)
     h = canvas.hud
-    small, big, _ = hud.faces(H)
+    small, big, _ = hud_text.faces(H)
     box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]  # the clock's cells at 256x144 (6x13)
-    want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *big)
+    want = expected_text(canvas, "t =  0.40 s", hud_text.WHITE, h.m, h.m, *big)
     np.testing.assert_array_equal(frames[-1][box], want[box])
     tips = tip_positions(name, sim.q.to_numpy())
     spread = np.hypot(*np.diff(tips, axis=0).T).max()
@@ -65,13 +65,14 @@ def test_the_clock_turns_amber_then_red_past_the_certificates_marks_and_the_time
     h = canvas.hud
     box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]
     byte = lambda c: tuple(int(np.floor(v * 255 + 0.5)) for v in c)  # noqa: E731
-    for f, colour in ((0, hud.WHITE), (1, hud.WHITE), (2, hud.AMBER), (3, hud.RED), (4, hud.RED)):  # t = 0 ... 0.4
+    for f, colour in ((0, hud_text.WHITE), (1, hud_text.WHITE), (2, hud_text.AMBER), (3, hud_text.RED),
+                      (4, hud_text.RED)):  # t = 0 ... 0.4
         lit = frames[f][box].reshape(-1, 3)
         lit = {tuple(p) for p in lit[lit.max(1) > 0]}
         assert lit == {byte(colour)}, (f, lit)
     below_axis = frames[-1][h.gy1 + 3 * h.th]
-    assert tuple(below_axis[h.x_of(0.15)]) == byte(hud.AMBER)
-    assert tuple(below_axis[h.x_of(0.25)]) == byte(hud.RED)
+    assert tuple(below_axis[h.x_of(0.15)]) == byte(hud_text.AMBER)
+    assert tuple(below_axis[h.x_of(0.25)]) == byte(hud_text.RED)
     assert below_axis[h.x_of(0.15) + 1:h.x_of(0.25)].max() == 0
 
 
@@ -90,7 +91,7 @@ def test_a_long_caption_wraps_in_its_corner_around_the_view_and_is_cut_there():
     assert len(lines) and lines.min() > view.cy  # the caption only, below the pivot
     assert not (added & view.reachable(h_px, w)).any()
     caption = [r for r in h.boxes if r[0] > view.cx]
-    assert len(caption) == hud.MAX_LINES  # wrapped to its most lines, the last one cut with an ellipsis
+    assert len(caption) == hud_text.MAX_LINES  # wrapped to its most lines, the last one cut with an ellipsis
     assert all(r[2] == w - h.m - 1 for r in caption)  # right-aligned
     assert added.mean() < 0.1  # the HUD is a frame around the picture, not over it
 
@@ -100,7 +101,7 @@ def test_a_single_pendulum_has_a_clock_and_a_timeline_but_no_spread():
     h = canvas.hud
     assert not h.fan and not hasattr(h, "spread")
     box = np.s_[h.m:h.m + 13, h.m:h.m + 6 * 11]
-    want = expected_text(canvas, "t =  0.40 s", hud.WHITE, h.m, h.m, *hud.faces(H)[1])
+    want = expected_text(canvas, "t =  0.40 s", hud_text.WHITE, h.m, h.m, *hud_text.faces(H)[1])
     np.testing.assert_array_equal(frames[-1][box], want[box])
     assert frames[-1][h.gy1 + 1, h.gx0:h.x_of(0.4)].min() > 0  # the timeline, lit up to now
 

@@ -167,7 +167,7 @@ def test_a_fitted_view_keeps_clear_of_a_band_and_the_nominal_one_is_kept_when_cl
 
 def test_coinciding_ticks_stay_apart_and_the_time_axis_is_labelled():
     """elastic_fan's certificate ends 0.11 s apart (2.28 s, 2.39 s): two ticks, a dark column between."""
-    from render.draw import hud
+    from render.draw import hud, hud_text
 
     runtime.init("cpu", "f64")
     scene = load("elastic_fan")
@@ -180,7 +180,7 @@ def test_coinciding_ticks_stay_apart_and_the_time_axis_is_labelled():
     h.draw(out, 5.0)
     row = out[h.gy0 + 2]
     byte = lambda c: tuple(int(v * 255 + 0.5) for v in c)  # noqa: E731
-    assert tuple(row[a]) == byte(hud.AMBER) and tuple(row[r]) == byte(hud.RED)
+    assert tuple(row[a]) == byte(hud_text.AMBER) and tuple(row[r]) == byte(hud_text.RED)
     assert row[a + h.th:r].max() == 0
     # the labels under the timeline: 0, both tick times and the end, none over another
     labels = h.time_labels()

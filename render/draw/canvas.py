@@ -1,10 +1,10 @@
 """An offscreen canvas: Taichi kernels that draw each frame straight into a numpy uint8 array.
 
-Antialiased coverage comes from the distance to each segment or circle. Primitives are composited with a
-max per channel (atomic where they are drawn in parallel), which does not depend on drawing order, so frames
-are byte-identical across runs and thread counts. Each effect has its own kernel, launched (and compiled)
-only when the scene calls for it. The pendulums' view (render/draw/framing.py) holds everything they can
-ever reach, clear of the HUD's boxes and of what the caller draws over the frame (keep_clear).
+Its primitives (render/draw/raster.py) are composited with a max per channel (atomic where they are drawn
+in parallel), which does not depend on drawing order, so frames are byte-identical across runs and thread
+counts. Each effect has its own kernel, launched (and compiled) only when the scene calls for it. The
+pendulums' view (render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and
+of what the caller draws over the frame (keep_clear).
 
 Speed (see benchmarks/README.md): a 720p frame is 0.9 M pixels, but a few hundred pendulums touch only a
 small part of it. Compositing works on TILE×TILE tiles that remember whether this frame's rods and bobs or a
@@ -17,9 +17,8 @@ import taichi as ti
 
 from ..physics import runtime
 from . import framing
+from .raster import COILS, Raster
 
-COILS = 14  # zig-zag segments per spring
-LEAD = 0.12  # straight fraction at each end of a spring
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
 # On a CPU with at most this many threads, primitives are drawn by one thread with a plain max instead of
@@ -29,22 +28,14 @@ SERIAL_MAX_THREADS = 4
 
 
 @ti.func
-def hue(h):
-    """HSV (h, 1, 1) to RGB, h in [0, 1)."""
-    k = ti.Vector([5.0, 3.0, 1.0])
-    c = (k + h * 6.0) % 6.0
-    return 1.0 - ti.max(0.0, ti.min(ti.min(c, 4.0 - c), 1.0))
-
-
-@ti.func
 def to_byte(c):
     """One channel of the accumulated colour (f32) to a byte; monotone, so it commutes with the max."""
     return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
 
 
 @ti.data_oriented
-class Canvas(runtime.Launcher):
-    TILE = TILE  # for render/draw/glow.py, which composes the canvas's tiles
+class Canvas(Raster, runtime.Launcher):
+    TILE = TILE  # for its primitives (render/draw/raster.py) and render/draw/glow.py, which mark and compose its tiles
 
     def __init__(self, scene, sim, info=None, keep_clear=()):
         """info: what the `hud` effect says beyond the drawing contract (render/draw/hud.py's Info; from the scene
@@ -169,93 +160,6 @@ class Canvas(runtime.Launcher):
         self.frame_no += 1
         return out
 
-    # ------------------------------------------------------------ primitives
-    @ti.func
-    def colour(self, i):
-        """video.palette: "fan", red to violet over the fan; "rainbow", the whole hue circle, so that a
-        coherent fan adds up to white under glow (each channel averages 1/2 over the circle)."""
-        h = 0.85 * i / ti.max(self.n - 1, 1) if self.n > 1 else 0.08
-        if ti.static(self.rainbow):
-            h = i / self.n
-        return hue(h)
-
-    @ti.func
-    def ink(self, i, max_scale, max_lift):
-        """Pendulum i's colour for a primitive: dimmed and lifted towards grey under max compositing, its
-        share of the light under glow."""
-        c = self.colour(i)
-        if ti.static(not self.glowing):
-            c = max_scale * c + max_lift
-        else:
-            c = self.gain * c
-        return c
-
-    @ti.func
-    def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c):
-        if 0 <= x < self.w and 0 <= y < self.h:
-            if ti.static(self.glowing):
-                self.glow.deposit(buf, y, x, c)
-            for k in ti.static(range(3) if not self.glowing else ()):
-                if ti.static(self.serial):
-                    buf[y, x][k] = ti.max(buf[y, x][k], c[k])
-                else:
-                    ti.atomic_max(buf[y, x][k], c[k])
-            tiles[y // TILE, x // TILE] = 1  # every writer stores the same 1: the race is harmless
-
-    @ti.func
-    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, flat: ti.template() = False):
-        """A line from a to b (x, y in pixels): under glow a hairline of light (render/draw/glow.py; `flat`: a
-        trail's pieces, which must not overlap), else antialiased with half-width r."""
-        if ti.static(self.glowing):
-            self.glow.segment(self, buf, tiles, a, b, c, flat)
-        else:
-            self.max_segment(buf, tiles, a, b, r, c)
-
-    @ti.func
-    def max_segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c):
-        """Antialiased segment of half-width r, walked along its major axis, composed with a max."""
-        swap = ti.abs(b[1] - a[1]) > ti.abs(b[0] - a[0])
-        if swap:
-            a, b = ti.Vector([a[1], a[0]]), ti.Vector([b[1], b[0]])
-        if a[0] > b[0]:
-            a, b = b, a
-        d = b - a
-        slope = d[1] / ti.max(d[0], 1e-6)
-        reach = int(ti.ceil(1.42 * r + 1.5))
-        # Pixels closer than r + 0.5 to the segment lie within this many pixels of its centre line along
-        # the minor axis (end caps included); the old fixed band of ±reach is kept as an outer bound.
-        band = (r + 0.5) * ti.sqrt(1.0 + slope * slope) + 0.01
-        ll = ti.max(d.norm_sqr(), 1e-12)
-        for u in range(int(ti.floor(a[0] - r - 1.0)), int(ti.ceil(b[0] + r + 1.0)) + 1):
-            vl = a[1] + slope * (ti.min(ti.max(u, a[0]), b[0]) - a[0])
-            vc = int(ti.round(vl))
-            lo, hi = ti.max(vc - reach, int(ti.ceil(vl - band))), ti.min(vc + reach, int(ti.floor(vl + band)))
-            for v in range(lo, hi + 1):
-                p = ti.Vector([ti.cast(u, ti.f32), ti.cast(v, ti.f32)])
-                t = ti.min(ti.max((p - a).dot(d) / ll, 0.0), 1.0)
-                cov = ti.min(ti.max(r + 0.5 - (p - a - t * d).norm(), 0.0), 1.0)
-                if cov > 0.0:
-                    if swap:
-                        self.plot(buf, tiles, u, v, c * cov)
-                    else:
-                        self.plot(buf, tiles, v, u, c * cov)
-
-    @ti.func
-    def disc(self, centre, r, c):
-        reach = int(r) + 2
-        cx, cy = int(ti.round(centre[0])), int(ti.round(centre[1]))
-        rr = (r + 0.5) * (r + 0.5)
-        for y in range(cy - reach, cy + reach + 1):
-            dy = ti.cast(y, ti.f32) - centre[1]
-            if dy * dy < rr:  # only the columns a row of the disc covers (with a hair of margin)
-                half = ti.sqrt(rr - dy * dy) + 0.01
-                for x in range(ti.max(cx - reach, int(ti.ceil(centre[0] - half))),
-                               ti.min(cx + reach, int(ti.floor(centre[0] + half))) + 1):
-                    dist = (ti.Vector([ti.cast(x, ti.f32), ti.cast(y, ti.f32)]) - centre).norm()
-                    cov = ti.min(ti.max(r + 0.5 - dist, 0.0), 1.0)
-                    if cov > 0.0:
-                        self.plot(self.rgb, self.drawn, y, x, c * cov)
-
     # ------------------------------------------------------------ kernels, one per effect
     @ti.func
     def joint(self, i, j: ti.template()):
@@ -323,23 +227,6 @@ class Canvas(runtime.Launcher):
                     a, b = self.joint(i, j), self.pos[i, j]
                     self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
                                  self.lw, self.ink(i, 0.55, 0.15))
-
-    @ti.func
-    def coil_node(self, a, b, k):
-        """Node k of the zig-zag from a to b: straight leads, then COILS alternating offsets."""
-        t = 0.0
-        side = 0.0
-        if k == 0:
-            t = 0.0
-        elif k == COILS + 2:
-            t = 1.0
-        else:
-            t = LEAD + (1.0 - 2.0 * LEAD) * (k - 1) / COILS
-            if 1 < k < COILS + 1:
-                side = 1.0 if k % 2 == 0 else -1.0
-        d = b - a
-        nrm = ti.Vector([-d[1], d[0]]) / ti.max(d.norm(), 1e-6)
-        return a + t * d + side * self.amp * nrm
 
     @ti.kernel
     def draw_bobs(self):

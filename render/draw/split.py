@@ -36,7 +36,7 @@ from ..physics import integrators, registry
 from ..physics.stepper import Run
 from ..trust import faithful
 from .font import text_height
-from .hud import faces, step
+from .hud_text import faces, step
 
 GAP = 2  # px of grey at least between panels
 DIVIDER = 72  # its grey level

@@ -3,7 +3,7 @@
 A 720p frame area-averaged down to 352 px turns its 6x13 and 10x20 text into grey mush and its one-pixel rods
 into faint smears. So, where the GIF's size or rate is not the video's, a second canvas of the GIF's size
 draws the same simulation (the same System, the same states: nothing is simulated twice) for the frames the
-GIF keeps, with a HUD laid out for that height (render/draw/hud.py picks its font by the frame's height) and
+GIF keeps, with a HUD laid out for that height (render/draw/hud_text.py picks its font by the frame's height) and
 trails that fade per GIF frame at the preset's trail_seconds. The frames the GIF skips still leave their
 stretch of the path in its trails, so a trail is the curve the bob drew, not chords between GIF frames: the
 canvas keeps where the last bob was at each (Canvas.follow) and stamps them with the next frame it draws.
