@@ -137,7 +137,7 @@ def ratio(ours: list[float], peer: list[float] | None) -> dict | None:
 def throughput_keys(rows: list[dict], render_s: float, video_s: float, mpl: dict | None = None) -> dict:
     """Issue 17's report keys from the sim phase's rows at N = 1e5, the timed rigid_chaos render and the
     matplotlib phase; a ratio against a peer that did not run (numba missing) is null. The rows come in
-    bench.SIM_PRESETS' order: the rigid pendulum's system first, then the elastic one's. Their spreads are
+    bench_sim.SIM_PRESETS' order: the rigid pendulum's system first, then the elastic one's. Their spreads are
     in spreads()."""
     rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
     at = {(r["system"], r["precision"]): r for r in rows if r["n"] == 10**5}
