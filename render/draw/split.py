@@ -10,6 +10,9 @@ Two passes, because Taichi holds one precision per process (render/physics/runti
    source like pipeline.Source), and every label in one kernel launch of the bundled font. A label owns a band
    across its panel's top (label_band), and the panel's canvas frames its pendulums' whole reach below it.
 
+Here are the panels' geometry (layout, the shared clock's band), the finest, the two passes and the metadata; the
+labels' words, colours and fonts are render/draw/split_text.py's.
+
 The finest variant is the one its certificate trusts longest (median, then first pendulum's faithful time);
 ties go to f64, the higher order, the smaller step, then the order given. It is only the best of those shown,
 not the truth: every panel, the finest too, says until when its own certificate (its own shadow run) holds it
@@ -28,7 +31,6 @@ from __future__ import annotations
 
 import json
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -37,65 +39,16 @@ from ..physics.stepper import Run
 from ..trust import faithful
 from .font import text_height
 from .hud_text import faces, step
+from .split_text import (COLOURS, INTEGRATOR, LABEL_SHARE, error_text, fit, label_band, label_face,
+                         preset_name, shown, turned, value_text)
 
 GAP = 2  # px of grey at least between panels
 DIVIDER = 72  # its grey level
-LARGE = 300  # panels at least this tall get the 10x20 font, smaller ones 6x13
-LABEL_SHARE = 0.4  # of a panel's height its label may cover (from the top)
-COLOURS = {"title": (1.0, 1.0, 1.0), "detail": (0.7, 0.7, 0.7), "close": (0.45, 0.95, 0.5),
-           "parted": (1.0, 0.55, 0.2), "finest": (0.55, 0.75, 1.0), "clock": (1.0, 1.0, 1.0)}
-DROP = (1, 2, 4)  # a short panel's label leaves out the integrator's line, then the cost, then its faithful time
-INTEGRATOR = ("integrator.method", "integrator.dt", "integrator.precision")  # said as run, once
 
 
 def cost(run: dict) -> float:
     """Wall seconds of simulation per simulated second, as measured in pass 1 (pipeline.record)."""
     return run["cost"]
-
-
-def shown(lines: list, room: int) -> list:
-    """The label's lines (label_lines) that fit in `room` lines, in their order, empty ones left out: the
-    integrator's line goes first, then the cost, then the faithful time; the variant and its error stay."""
-    kept = [k for k, (text, _) in enumerate(lines) if text]
-    drop = [k for k in DROP if k in kept][:max(0, len(kept) - room)]
-    return [lines[k] for k in kept if k not in drop]
-
-
-def label_face(height: int) -> tuple[str, int, int, int]:
-    """A label's font for panels `height` pixels high: (size, padding, line step, cell width) in pixels."""
-    return ("10x20", 8, 21, 10) if height >= LARGE else ("6x13", 4, 13, 6)
-
-
-def label_band(scene, height: int) -> int:
-    """How many pixels from a panel's top its label covers: as many lines as labels() shows there."""
-    _, pad_, step_, _ = label_face(height)
-    room = max(2, int(LABEL_SHARE * height) // step_)
-    named = dict(scene.compare)
-    lines = [("variant", None), ("" if all(k in named for k in INTEGRATOR) else "integrator", None),
-             ("cost", None), ("error", None), ("faithful", None)]  # label_lines' lines, by whether they are empty
-    return pad_ // 2 + len(shown(lines, room)) * step_ + pad_ // 2
-
-
-def fit(text: str, width: int, cell: int) -> str:
-    """Text cut to `width` pixels of `cell`-wide glyphs, so a label stays inside its panel."""
-    room = max(width // cell, 1)
-    return text if len(text) <= room else text[:room - 1] + "…"
-
-
-def amount(x: float) -> str:
-    """An error for a label: 3.1e-05 when small, 0.42 or 44 when large."""
-    return "0" if x == 0 else f"{x:.1e}" if x < 0.1 else f"{x:.2g}" if x < 10 else f"{x:.0f}"
-
-
-def turned(x):
-    """Angles (rad) wrapped to (−π, π]: a difference of whole turns is no difference on screen."""
-    r = np.pi - np.mod(np.pi - np.asarray(x, dtype=np.float64), 2 * np.pi)
-    return np.where(r <= -np.pi, r + 2 * np.pi, r)  # mod rounds a hair above π to 2π: back to π
-
-
-def error_text(delta: str, x: float, angles: bool) -> str:
-    """A panel's live error: `delta` (Δθ or Δx/L) and its size; an angle's wrapped, so it never reads above π."""
-    return f"{delta} {amount(abs(float(turned(x))))} rad" if angles else f"{delta} {amount(x)}"
 
 
 def clock_face(height: int) -> tuple[str, int]:
@@ -123,12 +76,6 @@ def layout(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
     return [((0, width - pw)[i % 2], ys[i // 2], pw, ph) for i in range(n)]
 
 
-def preset_name(scene) -> str:
-    """The name of the preset a comparison came from: its file's, not the folder's (NAME__<hash>, --name)."""
-    path = scene.source.split(" (compare variant", 1)[0]
-    return Path(path).stem if path.endswith(".toml") else scene.name
-
-
 def finest(runs: list[dict]) -> int:
     """The index of the variant taken as the truth the others are measured against."""
     def rank(i):
@@ -136,12 +83,6 @@ def finest(runs: list[dict]) -> int:
         return (c.median_until_s, c.faithful_until_s, c.fraction_faithful, integ["precision"] == "f64",
                 integrators.METHOD[integ["method"]].order, -integ["dt"], -i)
     return max(range(len(runs)), key=rank)
-
-
-def value_text(v) -> str:
-    if isinstance(v, float):
-        return f"{v:g}"
-    return json.dumps(v) if isinstance(v, (list, tuple, bool)) else str(v)
 
 
 class Replay:

@@ -128,7 +128,8 @@ class _Canvas:
 def _split(src, w: int, h: int, fps: int, skips: int):
     """A comparison's GIF: a SplitScreen of the GIF's size sharing the video's recorded runs (pass 1 is not run
     again), its panels drawn at the GIF's rate with the video's clock."""
-    from ..draw.split import LARGE, Replay, SplitScreen, label_band, layout
+    from ..draw.split import Replay, SplitScreen, layout
+    from ..draw.split_text import LARGE, label_band
 
     class Panel(Replay):
         def next_frame(self, out=None):
