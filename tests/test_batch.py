@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from render.commands import batch, gallery
+from render.commands import batch_plan, gallery
 from render.commands.cli import main
 
 PRESET = """description = "{desc}"
@@ -148,8 +148,8 @@ def test_dask_cluster_renders_the_same_frames(local_run, tmp_path, monkeypatch):
 
 def test_sweep_names_are_deterministic_and_valid(local_run):
     preset = str(local_run["good"] / "a_rigid.toml")
-    sweeps = batch.parse_sweeps(["pendulums.spread=1e-5,0.00002", "integrator.method=rk4,symplectic_euler"])
-    jobs = batch.plan([preset], [], sweeps)
+    sweeps = batch_plan.parse_sweeps(["pendulums.spread=1e-5,0.00002", "integrator.method=rk4,symplectic_euler"])
+    jobs = batch_plan.plan([preset], [], sweeps)
     names = [j["name"] for j in jobs]
     assert names == ["a_rigid__pendulums.spread_1e-05__integrator.method_rk4",
                      "a_rigid__pendulums.spread_1e-05__integrator.method_symplectic_euler",
@@ -157,7 +157,7 @@ def test_sweep_names_are_deterministic_and_valid(local_run):
                      "a_rigid__pendulums.spread_2e-05__integrator.method_symplectic_euler"]
     assert all(re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*", n) for n in names)
     assert jobs[2]["scene"].pendulums.spread == 2e-5 and jobs[3]["scene"].integrator.method == "symplectic_euler"
-    odd = batch.plan([preset], [], batch.parse_sweeps(['pendulums.lengths=[1.0, 2],[0.5,0.5]']))
+    odd = batch_plan.plan([preset], [], batch_plan.parse_sweeps(['pendulums.lengths=[1.0, 2],[0.5,0.5]']))
     assert [j["name"] for j in odd] == ["a_rigid__pendulums.lengths_1.0_2", "a_rigid__pendulums.lengths_0.5_0.5"]
 
 

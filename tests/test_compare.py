@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from render.commands import batch, cli
-from render.draw import hud_text, split
+from render.commands import batch_plan, cli
+from render.draw import hud_text, split, split_text
 from render.video import pipeline
 from render.draw.font import Font, text_height, text_width
 from render.config.options import output_name
@@ -85,9 +85,10 @@ def test_labels_show_the_variant_the_cost_and_the_live_error(precision):
     f32, f64 = meta["compare"]["panels"]
     label = lambda f, p: video[f, p["y"]:p["y"] + 56, p["x"]:p["x"] + p["width"]].astype(int)  # noqa: E731
     # the error line is green while the f32 panel stays within the tolerance, orange once it has parted
-    assert near(label(0, f32), split.COLOURS["close"]) > 20 and near(label(0, f32), split.COLOURS["parted"]) < 5
-    assert near(label(-1, f32), split.COLOURS["parted"]) > 20
-    assert near(label(-1, f64), split.COLOURS["finest"]) > 20  # the finest says so
+    close, parted = split_text.COLOURS["close"], split_text.COLOURS["parted"]
+    assert near(label(0, f32), close) > 20 and near(label(0, f32), parted) < 5
+    assert near(label(-1, f32), parted) > 20
+    assert near(label(-1, f64), split_text.COLOURS["finest"]) > 20  # the finest says so
     v32, v64 = meta["compare"]["variants"]
     assert meta["compare"]["finest"] == 1 and v64["divergence_s"] is None
     assert 0.5 < v32["divergence_s"] < 8 and v32["max_error"] > 0.1 and v32["tolerance"] == 1e-3
@@ -142,24 +143,24 @@ def test_the_split_screen_is_a_frame_source_deterministic_at_any_thread_count(me
                                      (144.0, "Δθ 0.51 rad"), (2 * np.pi + 1e-3, "Δθ 1.0e-03 rad"),
                                      (np.pi, "Δθ 3.1 rad"), (-np.pi, "Δθ 3.1 rad")])
 def test_an_angle_error_is_wrapped(x, text):
-    assert split.error_text("Δθ", x, True) == text  # 144 rad is 23 turns less 0.513 rad
+    assert split_text.error_text("Δθ", x, True) == text  # 144 rad is 23 turns less 0.513 rad
 
 
 def test_an_angle_error_never_reads_above_pi():
     xs = np.concatenate([np.linspace(-150, 150, 30001), [144.0, np.pi, -np.pi, 3 * np.pi, np.nextafter(np.pi, 4)]])
-    read = [float(split.error_text("Δθ", x, True).split()[1]) for x in xs]
+    read = [float(split_text.error_text("Δθ", x, True).split()[1]) for x in xs]
     assert max(read) <= np.pi and max(read) == 3.1
-    wrapped = split.turned(xs)
+    wrapped = split_text.turned(xs)
     assert np.all((wrapped > -np.pi) & (wrapped <= np.pi))  # (−π, π]
     assert np.allclose(np.cos(wrapped), np.cos(xs)) and np.allclose(np.sin(wrapped), np.sin(xs))  # the same angle
-    assert split.error_text("Δx/L", 44.0, False) == "Δx/L 44"  # a spring's stretch is not an angle
+    assert split_text.error_text("Δx/L", 44.0, False) == "Δx/L 44"  # a spring's stretch is not an angle
 
 
 def test_the_legend_is_titled_by_the_preset_not_its_folder():
     for sets, name in (([], None), (["video.fps=30"], None), (["video.fps=30"], "mine")):
         scene = output_name(load("compare_methods", sets), bool(sets), name)
-        assert split.preset_name(scene) == "compare_methods", scene.name
-    assert split.preset_name(scene.variants()[1]) == "compare_methods"  # a variant's source names the preset
+        assert split_text.preset_name(scene) == "compare_methods", scene.name
+    assert split_text.preset_name(scene.variants()[1]) == "compare_methods"  # a variant's source names the preset
 
 
 @pytest.fixture(scope="module")
@@ -215,7 +216,7 @@ def test_one_shared_clock_is_drawn_big_across_the_top(precision_frames):
     font = Font()
     for f in (0, 37, 99):
         alone = np.zeros((top, 256, 3), np.uint8)
-        font.draw(alone, f"t = {f / 10:5.2f} s", 128, split.pad(144), colour=split.COLOURS["clock"], size=size,
+        font.draw(alone, f"t = {f / 10:5.2f} s", 128, split.pad(144), colour=split_text.COLOURS["clock"], size=size,
                   scale=scale, ha="center")
         assert np.array_equal(frames[f][:top], alone), f  # the band holds the clock and nothing else
         assert (frames[f][top:top + split.GAP] == split.DIVIDER).all()  # then the grey line over the panels
@@ -307,7 +308,7 @@ def test_a_set_render_leaves_the_preset_folder_byte_identical(tmp_path):
     meta = json.loads((made[0] / "metadata.json").read_text())
     assert meta["preset"]["pendulums"]["gravity"] == 9.81 and (made[0] / f"{made[0].name}.mp4").stat().st_size
     # the same result however spelled: the hash is of the resolved scene
-    assert batch.plan([str(preset)], ["pendulums.gravity=9.810"], [])[0]["name"] == made[0].name
+    assert batch_plan.plan([str(preset)], ["pendulums.gravity=9.810"], [])[0]["name"] == made[0].name
 
     code, stdout, err = main("render", preset, "--out", out, "--no-progress", "--set", "pendulums.gravity=9.81",
                              "--name", "heavier")
@@ -319,13 +320,13 @@ def test_a_set_render_leaves_the_preset_folder_byte_identical(tmp_path):
 
 
 def test_batch_follows_the_same_rule():
-    plain = batch.plan(["classic"], [], [])[0]
+    plain = batch_plan.plan(["classic"], [], [])[0]
     assert plain["name"] == "classic"
-    over = batch.plan(["classic"], ["video.fps=30"], [])[0]
+    over = batch_plan.plan(["classic"], ["video.fps=30"], [])[0]
     assert re.fullmatch(r"classic__[0-9a-f]{8}", over["name"]) and over["scene"].name == over["name"]
-    swept = batch.plan(["classic"], [], batch.parse_sweeps(["video.fps=30,40"]))
+    swept = batch_plan.plan(["classic"], [], batch_plan.parse_sweeps(["video.fps=30,40"]))
     assert [j["name"] for j in swept] == ["classic__video.fps_30", "classic__video.fps_40"]
-    both = batch.plan(["classic"], ["pendulums.gravity=9.7"], batch.parse_sweeps(["video.fps=30"]))[0]["name"]
+    both = batch_plan.plan(["classic"], ["pendulums.gravity=9.7"], batch_plan.parse_sweeps(["video.fps=30"]))[0]["name"]
     assert re.fullmatch(r"classic__video\.fps_30__[0-9a-f]{8}", both)
 
 

@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import out_folder, run_cli
-from render.commands import batch, cli
+from render.commands import batch, batch_plan, cli
 from render.config import budget, estimate
 from render.video import pipeline
 from render.physics import registry, runtime
@@ -257,8 +257,8 @@ def test_fuzzed_batch_options_are_accepted_or_refused_as_bad_input(scheduler, sw
     except SceneError:
         pass
     try:
-        for key, vals in batch.parse_sweeps(sweeps):
-            assert vals and all(name == batch._sanitize(name) for _, name in vals)
+        for key, vals in batch_plan.parse_sweeps(sweeps):
+            assert vals and all(name == batch_plan._sanitize(name) for _, name in vals)
     except SceneError:
         pass
 

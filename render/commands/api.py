@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 
 from ..config import budget, scene as scenes
-from . import batch
+from . import batch_plan
 from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
@@ -172,12 +172,12 @@ def with_vary(scene, items: list[str]):
         return scene
     for item in items:  # which keys may vary, before their values are parsed
         key = item.partition("=")[0].strip()
-        batch.check_key(key, "--vary")
+        batch_plan.check_key(key, "--vary")
         why = vary_refusal(key)
         if why:
             raise SceneError(f"--vary {key}: cannot vary: {why}; {VARYING}")
     vary = {}
-    for key, vals in batch.parse_sweeps(items, "--vary"):
+    for key, vals in batch_plan.parse_sweeps(items, "--vary"):
         if key in vary:
             raise SceneError(f"--vary {key}: given twice; list every value in one --vary")
         lo, hi = VARIANTS
