@@ -99,3 +99,30 @@ def test_a_free_system_with_the_same_constants_is_reused_and_gives_the_same_stat
     assert fields_again == fields  # the run reports the fields it holds, as a new one does
     other = Run(scene.replace(pendulums={"masses": [1.0, 2.0]}))  # another constant: its own kernels
     assert other.sim is not again.sim
+
+
+def test_a_scene_is_planned_once_and_its_kept_start_cannot_be_written_through(monkeypatch):
+    """render/physics/plan.py keeps a scene's start and step: planning it again (under another name, or a
+    subset) runs no initial_state, returns the same values, and a caller writing into what it got changes
+    nothing kept; starts beyond PLANNED_BYTES are planned afresh every time."""
+    from render.config.scene import load
+    from render.physics import plan, registry
+
+    monkeypatch.setattr(plan, "_PLANNED", {})
+    scene = load("fractal_flip", ["video.width=160", "video.height=90"])
+    cls = registry.get(scene.system)
+    calls, state = [], cls.initial_state
+    monkeypatch.setattr(cls, "initial_state", lambda self: (calls.append(self.scene.name), state(self))[1])
+    first = cls(scene)
+    fresh_q, fresh_v = state(first)
+    q, v = first.start(scene.replace(name="other"))
+    assert len(calls) == 1 and np.array_equal(q, fresh_q) and np.array_equal(v, fresh_v)
+    q[:] = 99.0
+    again = cls(scene, subset=np.array([0, 7]))
+    assert len(calls) == 1 and (again.h, again.substeps) == (first.h, first.substeps)
+    assert np.array_equal(again.start(scene, np.array([0, 7]))[0], fresh_q[[0, 7]])
+    monkeypatch.setattr(plan, "PLANNED_BYTES", fresh_q.nbytes)  # q and v together no longer fit
+    bigger = scene.replace(video={"width": 192, "height": 108})
+    cls(bigger)
+    cls(bigger)
+    assert len(calls) == 3

@@ -24,7 +24,7 @@ from ..physics import registry
 from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_writable, positive_int,
-                      progress_wanted, thread_count, usable_cores)
+                              progress_wanted, thread_count, usable_cores)
 from ..video.tiled import connect, scheduler_address
 from ..video.version import __version__
 

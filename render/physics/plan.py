@@ -18,9 +18,19 @@ from . import grid, integrators, keys, poincare
 
 # Planning a map is not free: a 720p map's 381,924 starts and the bound on their fastest rate take 0.23 s. A
 # map's certificate plans its scene three times and its shadow's twice (its own step, then each Run's plan and
-# system), and the render once more; so this process keeps the last plans, by the scene less its name.
+# system), and the render once more; so this process keeps its last plans, by the scene less its name, up to
+# PLANNED_BYTES of starts (a 720p map's are 12 MB; a 4K map's, 265 MB, are planned afresh instead of held).
 _PLANNED: dict = {}
-PLANNED_SIZE = 8
+PLANNED_BYTES = 64 << 20
+
+
+def keep_plan(key: str, q0: np.ndarray, v0: np.ndarray, step: tuple):
+    """Keep a plan (the oldest go first) if its starts fit within PLANNED_BYTES."""
+    if q0.nbytes + v0.nbytes > PLANNED_BYTES:
+        return
+    _PLANNED[key] = q0, v0, step
+    while sum(q.nbytes + v.nbytes for q, v, _ in _PLANNED.values()) > PLANNED_BYTES:
+        del _PLANNED[next(iter(_PLANNED))]
 
 
 class Plan:
@@ -61,16 +71,18 @@ class Plan:
         self.g = p.gravity
         self.lengths, self.masses = tuple(p.lengths), tuple(p.masses)
         key = repr(dataclasses.replace(scene, name="", description="", budget=None))
-        if key not in _PLANNED:
+        if key in _PLANNED:
+            q0, v0, (self.h, self.substeps) = _PLANNED[key]
+        else:
             q0, v0 = self.initial_state()
-            _PLANNED[key] = q0, v0, integrators.timestep(scene, self.omega_max(q0, v0),
+            self.h, self.substeps = integrators.timestep(scene, self.omega_max(q0, v0),
                                                          self.energy_limit(q0, v0, self.method))
-            while len(_PLANNED) > PLANNED_SIZE:
-                del _PLANNED[next(iter(_PLANNED))]
-        q0, v0, (self.h, self.substeps) = _PLANNED[key]
+            keep_plan(key, q0, v0, (self.h, self.substeps))
         integrators.check_substeps(scene, self.substeps, self.h)  # "auto" is known only now: before any work
-        q0, v0 = (q0, v0) if subset is None else (q0[subset], v0[subset])
-        q0, v0 = q0.copy(), v0.copy()  # the planned start stays as it was
+        if subset is not None:
+            q0, v0 = q0[subset], v0[subset]
+        elif key in _PLANNED:  # the kept start stays as it was
+            q0, v0 = q0.copy(), v0.copy()
         self.n, self.subset = len(q0), subset
         return q0, v0
 
