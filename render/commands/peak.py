@@ -26,6 +26,7 @@ from ..physics import runtime
 CHAINS, UNROLL = 12, 8
 LANES = {"f64": 16, "f32": 32}  # 4 AVX2 registers of lanes either way (System.CHUNK)
 GROUPS = 1024  # parallel items: many per core even on a large machine, so a busy core delays only its share
+# (spread by runtime.SPREAD: in Taichi's blocks of 512 iterations they were two tasks, two threads at most)
 B, C = 0.999, 0.001  # a -> c / (1 - b) = 1 from any start: no overflow, no subnormal, at any iteration count
 
 # Flops of one RK4 step of one rigid double pendulum (RigidKernels.accel, render/physics/sincos.py, steps.rk4), each
@@ -64,20 +65,23 @@ class Peak:
     def chains(self, iters: ti.i32, b: float, c: float):
         """iters x UNROLL steps of a <- a·b + c on every accumulator; a starts at start(g, k, lane)."""
         L = ti.static(self.lanes)
-        for g in range(self.groups):
-            A = ti.Matrix.zero(float, CHAINS, L)
-            for lane in range(L):
-                for k in ti.static(range(CHAINS)):
-                    A[k, lane] = self.start(g, k, lane)
-            for _ in range(iters):
-                for lane in range(L):  # the loop LLVM vectorises
-                    a = A[:, lane]
-                    for _u in ti.static(range(UNROLL)):
-                        a = a * b + c
-                    A[:, lane] = a
-            for lane in range(L):
-                for k in ti.static(range(CHAINS)):
-                    self.out[g, k, lane] = A[k, lane]
+        S = ti.static(runtime.SPREAD)
+        for t in range(self.groups * S):  # spread over the threads as the advance kernel is (runtime.SPREAD)
+            if t % S == 0:
+                g = t // S
+                A = ti.Matrix.zero(float, CHAINS, L)
+                for lane in range(L):
+                    for k in ti.static(range(CHAINS)):
+                        A[k, lane] = self.start(g, k, lane)
+                for _ in range(iters):
+                    for lane in range(L):  # the loop LLVM vectorises
+                        a = A[:, lane]
+                        for _u in ti.static(range(UNROLL)):
+                            a = a * b + c
+                        A[:, lane] = a
+                for lane in range(L):
+                    for k in ti.static(range(CHAINS)):
+                        self.out[g, k, lane] = A[k, lane]
 
     @ti.func
     def start(self, g, k, lane):

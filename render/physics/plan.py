@@ -19,7 +19,7 @@ from . import grid, integrators, keys, poincare
 # Planning a map is not free: a 720p map's 381,924 starts and the bound on their fastest rate take 0.23 s. A
 # map's certificate plans its scene three times and its shadow's twice (its own step, then each Run's plan and
 # system), and the render once more; so this process keeps its last plans, by the scene less its name, up to
-# PLANNED_BYTES of starts (a 720p map's are 12 MB; a 4K map's, 265 MB, are planned afresh instead of held).
+# PLANNED_BYTES of starts (a 720p map's are 12 MB; a 4K map's, 129 MB, are planned afresh instead of held).
 _PLANNED: dict = {}
 PLANNED_BYTES = 64 << 20
 

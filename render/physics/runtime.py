@@ -23,12 +23,12 @@ _generation = 0  # how many times Taichi was (re)initialised: fields of an older
 launched: list[str] = []  # kernel names in first-launch order, since the last init
 
 # Taichi 1.7.4's CPU backend hands a parallel range-for to its threads in blocks of at least 512 iterations,
-# whatever loop_config(block_dim=...), default_cpu_block_dim or cpu_block_dim_adaptive say (measured: 95 heavy
-# iterations ran on one of 2 threads, 600 split 512 to 88). A loop over groups of pendulums has few, heavy
-# iterations: the certificate's 1521 pixels in f64 are 96 groups, all on one thread, and 1e5 pendulums in f32
-# 3125 groups, 7 blocks for 2 threads. So such a loop runs over SPREAD iterations per group, of which only the
-# first works (`if t % SPREAD == 0`): a block is then 512 / SPREAD groups, and the idle iterations cost a
-# compare each. Which thread steps a group never changes its bits.
+# whatever loop_config(block_dim=...), default_cpu_block_dim or cpu_block_dim_adaptive say
+# (benchmarks/thread_blocks.py: 95 heavy iterations ran on one of 2 threads, 600 split 512 to 88). A loop over
+# groups of pendulums has few, heavy iterations: the certificate's 1521 pixels in f64 are 96 groups, all on one
+# thread, and 1e5 pendulums in f32 3125 groups, 7 blocks for 2 threads. So such a loop runs over SPREAD
+# iterations per group, of which only the first works (`if t % SPREAD == 0`): a block is then 512 / SPREAD
+# groups, and the idle iterations cost a compare each. Which thread steps a group never changes its bits.
 SPREAD = 128
 
 
