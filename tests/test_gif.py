@@ -176,6 +176,27 @@ def test_the_gif_is_byte_identical_at_one_and_two_threads(rigid, tmp_path):
     assert again.read_bytes() == path.read_bytes()
 
 
+def test_a_gif_alone_is_the_same_bytes_and_no_frame_of_the_videos_size_is_drawn(rigid, tmp_path):
+    """formats = ["gif"]: the GIF's canvas draws from the System as before, and the video's canvas, whose frames
+    nothing would take, draws none (it was nine tenths of such a render)."""
+    from render.draw.canvas import Canvas
+    scene, path = rigid[0], rigid[1]
+    alone = dataclasses.replace(scene, video=dataclasses.replace(scene.video, formats=("gif",)))
+    sizes, real_draw = [], Canvas.draw
+
+    def draw(self, *a, **kw):
+        sizes.append((self.w, self.h))
+        return real_draw(self, *a, **kw)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Canvas, "draw", draw)
+        pipeline.render(alone, tmp_path, threads=1)
+    d = alone.out_dir(tmp_path)
+    assert sorted(p.name for p in d.iterdir()) == ["metadata.json", f"{alone.name}.gif"]
+    assert (d / f"{alone.name}.gif").read_bytes() == path.read_bytes()
+    assert set(sizes) == {gif.size(scene.video)} and len(sizes) == len(picks(scene))
+
+
 # ---------------------------------------------------------------- (2) the rainbow stays a rainbow
 BINS = 36
 

@@ -186,8 +186,11 @@ class Frames:
                 and not scene.has("poincare"):
             own = _split if scene.compare else _Canvas
             self.own = own(src, self.w, self.h, fps, gap(self.repeats))
+        # A fan's GIF canvas reads only the System's state: a render of the GIF alone need not draw the video's
+        # frames at all (a comparison's GIF panels replay what the video's split screen records as it draws).
+        self.alone = isinstance(self.own, _Canvas)
 
-    def frame(self, f: int, video_frame: np.ndarray) -> np.ndarray | None:
+    def frame(self, f: int, video_frame: np.ndarray | None) -> np.ndarray | None:
         t = time.perf_counter()
         out = None
         if self.own is None:
