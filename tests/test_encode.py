@@ -57,6 +57,37 @@ def test_the_gif_is_byte_identical_to_the_one_the_fps_filter_made(tmp_path):
     assert piped == 16 and piped == len(list(itertools.islice(frames, 0, n, 3)))
 
 
+def test_the_gif_palette_is_chosen_from_colours_cut_to_palette_bits_and_maps_the_full_frames(tmp_path):
+    """The Encoder's GIF is, bit for bit, the GIF of a palette made (by ffmpeg's own palettegen, with the
+    shipped settings) from the frames cut in numpy to PALETTE_BITS per channel at each step's centre, mapped
+    onto the uncut frames; and cutting changes the palette of these frames, so the test can tell."""
+    v, n = video(20, 20, 48, 28, 48), 12
+    rng = np.random.default_rng(11)
+    frames = [rng.integers(0, 256, (28, 48, 3), dtype=np.uint8) for _ in range(n)]
+    enc = encode.Encoder(tmp_path, "cut", v, n, formats=["gif"])
+    for f in frames:
+        enc.write(f)
+    enc.close()
+    mask, centre = encode.palette_cut()
+    assert encode.PALETTE_BITS < 8 and bin(mask).count("1") == encode.PALETTE_BITS
+    make = f"stats_mode=diff:max_colors={encode.GIF_COLOURS}"
+
+    def two_inputs(stats: list[np.ndarray], name: str) -> bytes:
+        (tmp_path / "stats.raw").write_bytes(b"".join(f.tobytes() for f in stats))
+        (tmp_path / "frames.raw").write_bytes(b"".join(f.tobytes() for f in frames))
+        raw = ["-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "48x28", "-r", "20", "-i"]
+        cmd = [EXE, "-nostdin", "-loglevel", "error", *raw, str(tmp_path / "stats.raw"), *raw,
+               str(tmp_path / "frames.raw"), "-an", "-lavfi",
+               f"[0]palettegen={make}[p];[1][p]paletteuse=dither=bayer:bayer_scale=3", "-loop", "0", "-f", "gif",
+               str(tmp_path / name)]
+        subprocess.run(cmd, check=True)
+        return (tmp_path / name).read_bytes()
+
+    cut = two_inputs([(f & mask) | centre for f in frames], "cut_ref.gif")
+    assert (tmp_path / "cut.gif").read_bytes() == cut
+    assert two_inputs(frames, "uncut.gif") != cut
+
+
 def area_reference(frame: np.ndarray, w: int, h: int) -> np.ndarray:
     """An area average written independently: each output pixel integrates the frame, upsampled by the least
     common multiple of the sizes (so every output pixel covers whole sub-pixels), over its rectangle."""
