@@ -82,9 +82,10 @@ def mp4_args(video) -> list[str]:
             "-movflags", "+faststart", "-f", "mp4"]
 
 
-def palette_cut() -> tuple[int, int]:
-    """(mask, centre): a channel value v counts for the GIF's palette as (v & mask) | centre (PALETTE_BITS)."""
-    drop = 8 - PALETTE_BITS
+def palette_cut(bits: int | None = None) -> tuple[int, int]:
+    """(mask, centre): a channel value v counts for the GIF's palette as (v & mask) | centre, cut to `bits`
+    (default PALETTE_BITS)."""
+    drop = 8 - (PALETTE_BITS if bits is None else bits)
     return (0xFF << drop) & 0xFF, (1 << drop) >> 1
 
 
@@ -93,7 +94,7 @@ def gif_args(video) -> list[str]:
     make, use = (f"stats_mode=single:max_colors={RAINBOW_COLOURS}", "new=1:") if video.palette == "rainbow" else \
         (f"stats_mode=diff:max_colors={GIF_COLOURS}", "")
     cut = ""  # a rainbow's palettes are made per frame, as frames come: no tail to cut
-    if video.palette != "rainbow":
+    if video.palette != "rainbow" and PALETTE_BITS < 8:
         keep, centre = palette_cut()
         cut = "lutrgb=" + ":".join(f"{c}='bitor(bitand(val\\,{keep})\\,{centre})'" for c in "rgb") + ","
     graph = f"split[a][b];[a]{cut}palettegen={make}[p];[b][p]paletteuse={use}dither=bayer:bayer_scale=3"
