@@ -178,7 +178,7 @@ def test_the_gif_is_byte_identical_at_one_and_two_threads(rigid, tmp_path):
 
 def test_a_gif_alone_is_the_same_bytes_and_no_frame_of_the_videos_size_is_drawn(rigid, tmp_path):
     """formats = ["gif"]: the GIF's canvas draws from the System as before, and the video's canvas, whose frames
-    nothing would take, draws none (it was nine tenths of such a render)."""
+    nothing would take, draws none (they were half of such a render's time)."""
     from render.draw.canvas import Canvas
     scene, path = rigid[0], rigid[1]
     alone = dataclasses.replace(scene, video=dataclasses.replace(scene.video, formats=("gif",)))
