@@ -3,14 +3,14 @@
     .venv/bin/python benchmarks/gif_palette.py [PRESET] [--bits 8 7 6] [--rate 50]
 
 The preset's GIF frames are drawn once, as a render draws them (render/video/gif.py), and kept in memory. Then,
-for each number of bits, they are fed to the GIF's ffmpeg (encode.gif_args) at `rate` frames per second, about
-as fast as a render hands them over, and the seconds ffmpeg still needs after the last frame are timed: the
-render waits for them. Each GIF is decoded and compared with the raw frames (PSNR, whole frame and the HUD
+for each number of bits, they are fed to the render's Encoder at `rate` frames per second, about as fast as a
+render hands them over, and its close() is timed: the seconds ffmpeg still needs after the last frame, which
+the render waits for. Each GIF is decoded and compared with the raw frames (PSNR, whole frame and the HUD
 clock's corner). 8 bits is no cut. The rounds are interleaved (8, 7, 6, 8, 7, 6, ...) and the median kept.
 """
 import argparse
+import dataclasses
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -39,20 +39,19 @@ def gif_frames(name: str) -> tuple[object, list[np.ndarray]]:
 
 
 def tail(scene, frames, bits: int, rate: float, out: Path) -> float:
-    """Seconds from the last frame written to ffmpeg's exit, feeding `rate` frames per second."""
+    """Seconds the render's Encoder spends in close() (the GIF's palette and mapping after the last frame), fed
+    `rate` frames per second. Its video is the GIF's own size and rate, so each frame is one GIF frame."""
     encode.PALETTE_BITS = bits
     h, w = frames[0].shape[:2]
-    cmd = [encode.imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo",
-           "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", str(gif.rate(scene.video)), "-i", "-", "-an",
-           *encode.gif_args(scene.video), str(out)]
-    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE)
+    video = dataclasses.replace(scene.video, width=w, height=h, gif_width=w, fps=gif.rate(scene.video),
+                                formats=("gif",))
+    enc = encode.Encoder(out, f"{bits}", video, len(frames))
     start = time.perf_counter()
     for k, f in enumerate(frames):
-        proc.stdin.write(f.tobytes())
+        enc.write(f)
         time.sleep(max(0.0, start + (k + 1) / rate - time.perf_counter()))
-    proc.stdin.close()
     t = time.perf_counter()
-    proc.wait()
+    enc.close()
     return time.perf_counter() - t
 
 
@@ -80,7 +79,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(args.rounds):
             for b in args.bits:
-                waits[b].append(tail(scene, frames, b, args.rate, Path(tmp) / f"{b}.gif"))
+                waits[b].append(tail(scene, frames, b, args.rate, Path(tmp)))
         print(f"{args.preset}: {len(frames)} GIF frames of {raw.shape[2]}x{raw.shape[1]}, fed at {args.rate:g}/s")
         print("| bits | distinct colours | wait after the last frame, s (rounds) | MB | PSNR dB | clock corner dB |")
         print("|---:|---:|---|---:|---:|---:|")

@@ -59,8 +59,9 @@ GIF_COLOURS, RAINBOW_COLOURS = 48, 256
 # The GIF's palette is chosen from its frames' colours cut to PALETTE_BITS bits per channel (the centre of each
 # step), and its frames are mapped to it at full depth. palettegen's median cut sorts every distinct colour of
 # the whole GIF, after its last frame, on one thread: rigid_chaos's 400 GIF frames hold 1.83 M colours (773 k at
-# 7 bits, 194 k at 6), and its render waited 6.1-8.1 s on the GIF after the last frame (7 bits: 3.8-4.4 s; 6:
-# 2.6-3.5 s). Against its raw frames 7 bits cost 0.04 dB (0.10 in the clock's corner), 6 bits 0.18 (0.96).
+# 7 bits, 194 k at 6), and the Encoder's close() took 7.83 s after the last frame (7 bits: 4.57 s; 6: 3.07 s;
+# medians of 3 rounds, `python benchmarks/gif_palette.py --rounds 3`, a 2-core AVX2 EPYC). Against its raw
+# frames 7 bits cost 0.04 dB (0.10 in the clock's corner), 6 bits 0.18 (0.96).
 PALETTE_BITS = 7
 REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
