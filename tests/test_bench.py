@@ -2,6 +2,7 @@
 preset renders (small) one pendulum per pixel."""
 import json
 import math
+import statistics
 import sys
 from pathlib import Path
 
@@ -70,6 +71,10 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
     # the numpy baseline integrates the same equations: f64 agrees to round-off, f32 to its own precision
     for s in rep["sim"]:
         assert s["agree"] < (1e-9 if s["precision"] == "f64" else 1e-3), s
+        # every side's rate in every round, so that another summary than the median can be drawn from a report
+        assert all(len(r) == 2 for r in s["rounds"].values()) and {"taichi", "numpy"} <= set(s["rounds"]), s
+        assert s["taichi"] / s["numpy"] == pytest.approx(statistics.median(s["rounds"]["taichi"])
+                                                         / statistics.median(s["rounds"]["numpy"]))
     md = (out / "report.md").read_text()
     assert "end_to_end_over_encode_floor" in md and "| rigid | f64 |" in md and "| flip_time | fractal_flip |" in md
     assert "## rainbow_1000" in md and "fraction of peak" in md and "range over 2 rounds" in md

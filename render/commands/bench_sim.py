@@ -50,7 +50,8 @@ def phase_sim(cfg, arch, tmp) -> dict:
                 rows.append({"system": scene.system, "precision": prec, "n": n, "taichi": med["taichi"],
                              "numpy": med["numpy"], "numba": med.get("numba"),
                              "speedup": med["taichi"] / med["numpy"], "agree": agree,
-                             "vs": {p: peers.ratio(runs["taichi"], runs.get(p)) for p in ("numpy", "numba")}})
+                             "vs": {p: peers.ratio(runs["taichi"], runs.get(p)) for p in ("numpy", "numba")},
+                             "rounds": runs})
                 if "peak" in runs:  # the kernel's flop rate, round by round, over the peak's in the same round
                     per = peak.rigid_rk4_flops(prec, scene.pendulums.lengths, scene.pendulums.masses)
                     flops = [r * per for r in runs["taichi"]]
