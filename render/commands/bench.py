@@ -1,7 +1,8 @@
 """`pendulum bench`: how close a render comes to the encoder's floor, simulation vs numpy, and the fractal.
 
-Every phase runs in its own subprocess (a fresh Taichi runtime) while this process samples the resident memory
-of that process tree (ffmpeg included), so all figures of one report come from one run. Precision is fixed
+Every phase runs in its own subprocess (a fresh Taichi runtime: render/commands/bench_process.py) while this
+process samples the resident memory of that process tree (ffmpeg included), so all figures of one report come
+from one run. Precision is fixed
 per Taichi init, so the simulation phase runs f32, then f64. Every ratio against a peer (numpy, numba,
 matplotlib, the peak rate of render/commands/peak.py) comes from --repeat interleaved rounds
 (render/commands/peers.py) and is reported with its spread over them. Method and findings:
@@ -14,7 +15,6 @@ import functools
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -24,10 +24,10 @@ import numpy as np
 
 from ..config import estimate
 from . import peers
+from .bench_process import maxrss_mb, run_phase
 from .bench_sim import phase_sim
 from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table
 from ..video.atomic import write_atomic
-from ..errors import SimulationError
 from ..config.options import check_writable, positive_int
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
@@ -105,52 +105,6 @@ def run(args) -> int:
               f"{'met' if t['met'] else 'not measured' if t['met'] is None else 'MISSED'}")
     print(f"-> {args.out}/report.md ({report['wall_s']:.0f} s)")
     return 0
-
-
-# ---------------------------------------------------------------- running phases, measuring memory
-
-def run_phase(name: str, args, tmp: Path) -> dict:
-    """One phase in a subprocess; its result plus the peak resident memory of its process tree."""
-    result = tmp / f"{name}.json"
-    cmd = [sys.executable, "-m", "render", "bench", "--phase", name, "--result", str(result), "--out", str(tmp),
-           "--arch", args.arch] + (["--quick"] if args.quick else []) + (
-           ["--repeat", str(args.repeat)] if args.repeat is not None else [])
-    proc, peak = subprocess.Popen(cmd, stdout=subprocess.DEVNULL), 0
-    try:  # the sum over the tree at one instant, which ru_maxrss (the largest single process) cannot give
-        while proc.poll() is None:
-            peak = max(peak, tree_rss(proc.pid))
-            time.sleep(0.05)
-    finally:
-        if proc.poll() is None:  # interrupted: do not leave the phase running
-            proc.terminate()
-            proc.wait()
-    code = proc.returncode
-    if code != 0:
-        raise SimulationError(f"bench phase {name!r} failed (exit {code}); see the messages above")
-    out = json.loads(result.read_text())
-    out["peak_mem_mb"] = max(peak / 2**20, out.pop("maxrss_mb"))  # /proc may be missing, or miss a spike
-    return out
-
-
-def tree_rss(pid: int) -> int:
-    """Resident bytes of a process and all its descendants (Linux /proc; 0 elsewhere)."""
-    total, todo, page = 0, [pid], os.sysconf("SC_PAGE_SIZE")
-    while todo:
-        p = todo.pop()
-        try:
-            with open(f"/proc/{p}/statm") as f:
-                total += int(f.read().split()[1]) * page
-            for tid in os.listdir(f"/proc/{p}/task"):
-                with open(f"/proc/{p}/task/{tid}/children") as f:
-                    todo += [int(c) for c in f.read().split()]
-        except (OSError, ValueError):
-            pass
-    return total
-
-
-def maxrss_mb() -> float:  # the largest single process: this phase, or one of its ffmpeg children
-    import resource
-    return max(resource.getrusage(w).ru_maxrss for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)) / 1024
 
 
 # ---------------------------------------------------------------- phases
