@@ -2,10 +2,9 @@
 
 Every phase runs in its own subprocess (a fresh Taichi runtime: render/commands/bench_process.py) while this
 process samples the resident memory of that process tree (ffmpeg included), so all figures of one report come
-from one run. Precision is fixed
-per Taichi init, so the simulation phase runs f32, then f64. Every ratio against a peer (numpy, numba,
-matplotlib, the peak rate of render/commands/peak.py) comes from --repeat interleaved rounds
-(render/commands/peers.py) and is reported with its spread over them. Method and findings:
+from one run. Precision is fixed per Taichi init, so the simulation phase runs f32, then f64. Every ratio
+against a peer (numpy, numba, matplotlib, the peak rate of render/commands/peak.py) comes from --repeat
+interleaved rounds (render/commands/peers.py) and is reported with its spread over them. Method and findings:
 benchmarks/README.md.
 """
 from __future__ import annotations
