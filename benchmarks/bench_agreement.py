@@ -3,31 +3,26 @@ summarised by its median (what `pendulum bench` reports) or by its best round.
 
     python benchmarks/bench_agreement.py [--runs 4] [--env MALLOC_TRIM_THRESHOLD_=1073741824 ...]
 
-Each run is the bench's own sim phase (`python -m render bench --phase sim`, the full ladder, 3 interleaved
-rounds) in a fresh process, one after the other, as two consecutive `pendulum bench` runs would be. For every
-ratio issue 27 asks to agree within 15 % (ours over numpy and numba, rigid and elastic, f32 and f64, and the
-rigid kernel's rate over the peak's), it prints the value of each run and the range across runs in % of the
-smallest. --env sets variables for the phase's process only (to try, say, glibc's malloc settings on the numpy
-peer's temporaries).
+Each run is the bench's own sim phase (render/commands/bench_process.py's run_phase: the full ladder, 3
+interleaved rounds) in a fresh process, one after the other, as two consecutive `pendulum bench` runs would
+be. For every ratio issue 27 asks to agree within 15 % (ours over numpy and numba, rigid and elastic, f32 and
+f64, and the rigid kernel's rate over the peak's), it prints the value of each run and the range across runs
+in % of the smallest. --env sets variables for the phases' processes (to try, say, glibc's malloc settings on
+the numpy peer's temporaries).
 """
 import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from types import SimpleNamespace
 
-ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from render.commands.bench_process import run_phase  # noqa: E402
+
 SUMMARY = {"median": statistics.median, "best": max}  # of a side's rates over the rounds
-
-
-def sim_phase(out: Path, env: dict) -> dict:
-    result = out / "sim.json"
-    subprocess.run([sys.executable, "-m", "render", "bench", "--phase", "sim", "--result", str(result),
-                    "--out", str(out)], cwd=ROOT, env={**os.environ, **env}, check=True, stdout=subprocess.DEVNULL)
-    return json.loads(result.read_text())
+FULL_CPU = SimpleNamespace(arch="cpu", quick=False, repeat=None)  # `pendulum bench`'s defaults
 
 
 def ratios(phase: dict, how) -> dict[str, float]:
@@ -48,11 +43,11 @@ def main() -> int:
     p.add_argument("--runs", type=int, default=4, help="consecutive runs of the sim phase (default 4)")
     p.add_argument("--env", nargs="*", default=[], metavar="KEY=VALUE", help="environment of the phase's process")
     args = p.parse_args()
-    env = dict(kv.split("=", 1) for kv in args.env)
+    os.environ.update(kv.split("=", 1) for kv in args.env)  # inherited by each phase's process
     with tempfile.TemporaryDirectory(prefix="bench-agreement-") as tmp:
         phases = []
         for i in range(args.runs):
-            phases.append(sim_phase(Path(tmp), env))
+            phases.append(run_phase("sim", FULL_CPU, Path(tmp)))  # as `pendulum bench` runs it
             print(f"run {i + 1} of {args.runs} done", file=sys.stderr)
     print(f"| ratio at N = 1e5 | summary | {' | '.join(f'run {i + 1}' for i in range(args.runs))} | range |")
     print("|---|---|" + "---:|" * (args.runs + 1))
