@@ -25,7 +25,7 @@ from ..config import estimate
 from . import peers
 from .bench_process import maxrss_mb, run_phase
 from .bench_sim import phase_sim
-from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table
+from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
 from ..video.atomic import write_atomic
 from ..config.options import check_writable, positive_int
 
@@ -95,7 +95,8 @@ def run(args) -> int:
     m = report["machine"]
     write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
         targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
-                                 f"{m['cpus']} CPUs ({m['cpu']}, {m['cpu_kind']} targets), load average "
+                                 f"{m['cpus']} CPUs ({m['cpu']}, {m['cpu_kind']} targets, {width_text(m)}), "
+                                 "load average "
                                  f"{m['load_avg'][0]:.2f} at the start and {m['load_avg_end'][0]:.2f} at the end, "
                                  f"{report['rounds']} interleaved rounds, numba {report['peers']['numba']}."]).encode()
         + b"\n")

@@ -10,6 +10,7 @@ import time
 import numpy as np
 
 from . import peers
+from ..physics import vector_width
 
 # Issue 27's table (the older issues' targets it does not restate kept); a goal given per CPU kind (cpu_kind():
 # AVX-512's wider vectors speed numpy's sin/cos as much as ours, so the ratios to the peers are lower there).
@@ -41,6 +42,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
     rep = {"quick": quick, "wall_s": wall, "created": time.strftime("%Y-%m-%d %H:%M:%S"),
            "rounds": mpl["vs"]["render"]["rounds"],
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind, "simd": simd_flags(),
+                       "vector_width": vector_width.planned(),  # the phases' processes set it so
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
            "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
@@ -92,6 +94,11 @@ def with_spread(s: dict | None, spec=".2f") -> str:
     return "null" if s is None else f"**{s['value']:{spec}}** ({spread_text(s, spec)})"
 
 
+def width_text(machine: dict) -> str:
+    w = machine.get("vector_width")
+    return f"kernels vectorised at {w} lanes" if w else "kernels vectorised at LLVM's own width"
+
+
 def load_text(load) -> str:
     return " / ".join(f"{x:.2f}" for x in load) + " (1 / 5 / 15 min)"
 
@@ -127,7 +134,8 @@ def markdown(r: dict) -> str:
     missed = [k for k, g in r["targets"].items() if not g["met"]]
     out = [f"# pendulum bench{' --quick' if r['quick'] else ''}", "",
            f"{r['created']}, {m['cpus']} CPUs ({m['cpu']}; {', '.join(m['simd']) or 'no AVX'}: {m['cpu_kind']} "
-           f"targets), Python {m['python']}, numpy {m['numpy']}, ffmpeg {m['ffmpeg']}. Every figure comes from "
+           f"targets; {width_text(m)}), Python {m['python']}, numpy {m['numpy']}, ffmpeg {m['ffmpeg']}. "
+           "Every figure comes from "
            f"this one run ({r['wall_s']:.0f} s); load average {load_text(m['load_avg'])} at the start, "
            f"{load_text(m['load_avg_end'])} at the end. Each ratio to a peer is the ratio of medians over "
            f"{r['rounds']} interleaved rounds (ours, the peer, ours again, ...), with the range of the per-round "

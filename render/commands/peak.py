@@ -10,7 +10,8 @@ vectors are enough to keep the multiply and add pipes busy through their latency
 of the shapes tried on an AVX2 machine here: 8 to 24 chains, 4 to 16 steps). The accumulators are written
 to a field, so nothing can be optimised away, and a run's result is a fixed function of its arguments
 (tests/test_peak.py: bit for bit the same recurrence in numpy). Checked in the generated assembly: the
-steps are vmulpd and vaddpd on ymm registers, no FMA.
+steps are vmulpd and vaddpd on ymm registers, no FMA (zmm where render/physics/vector_width.py sets 16 lanes,
+as it does for the RK4 kernel timed against this one).
 
 runtime.init runs Taichi with fast_math off, under which LLVM may not fuse a·b + c into an FMA: each step is
 a multiply and an add (2 flops, as an FMA counts them), the same instructions the rigid kernel is made of.

@@ -8,15 +8,15 @@ from __future__ import annotations
 import contextlib
 import functools
 import io
-import os
 import sys
-import tempfile
 import textwrap
 import warnings
 
 import taichi as ti
 from taichi.lang import kernel_impl
 from taichi.lang.ast import ast_transformer_utils
+
+from . import held_stderr, vector_width
 
 _current: tuple | None = None
 _generation = 0  # how many times Taichi was (re)initialised: fields of an older generation are gone
@@ -50,9 +50,11 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, 
               random_seed=0, offline_cache=True, fast_math=False)
     if threads:
         kw["cpu_max_num_threads"] = threads
+    if arch == "cpu":  # before the first kernel compiles: LLVM reads its options then
+        vector_width.apply()
     # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
     # ti.init prints "[Taichi] Starting on arch=..." to stdout unconditionally; stdout is for results.
-    with contextlib.redirect_stdout(io.StringIO()), _stderr_held():
+    with contextlib.redirect_stdout(io.StringIO()), held_stderr.held(_unless_failed):
         ti.init(arch=ti.cuda if arch == "cuda" else ti.cpu, **kw)
     used = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
     if arch == "cuda" and used == "cpu":
@@ -78,30 +80,10 @@ def forget():
     _current = None
 
 
-@contextlib.contextmanager
-def _stderr_held():
-    """Hold what Taichi's C++ side writes to fd 2 while it starts: when ti.init fails it logs the error there
-    and then raises it, and the CLI reports the exception as its one line. Released if the block succeeds."""
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):  # no fd 2 to hold
-        yield
-        return
-    with tempfile.TemporaryFile() as held:
-        os.dup2(held.fileno(), 2)
-        ok = False
-        try:
-            yield
-            ok = True
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            if ok:  # nothing was wrong: pass on whatever it said
-                held.seek(0)
-                text = held.read()
-                if text:
-                    os.write(2, text)
+def _unless_failed(text: bytes, ok: bool) -> bytes:
+    """When ti.init fails it logs the error on fd 2 and then raises it, and the CLI reports the exception as its
+    one line: what it wrote passes on only if it succeeded."""
+    return text if ok else b""
 
 
 def real():

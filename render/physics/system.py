@@ -143,7 +143,8 @@ class System(Plan, runtime.Launcher):
         Each group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
         stack array rather than chunk·D scalars), and each substep is a loop over those columns that steps one
         pendulum (a D × 1 lane matrix) at a time. With no call and no branch on values in the step, LLVM's
-        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction: that loop is the SIMD. Every
+        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction (16 in two AVX-512 registers where
+        render/physics/vector_width.py sets the width): that loop is the SIMD. Every
         pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
         at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
         B = ti.static(self.chunk)

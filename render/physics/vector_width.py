@@ -1,0 +1,179 @@
+"""512-bit vectors where LLVM would keep 256: its loop vectoriser told how many lanes to take.
+
+Taichi 1.7.4 compiles kernels with LLVM 15 for the host CPU by name, and LLVM's tuning for Intel's AVX-512
+CPUs (Skylake-X to Sapphire Rapids) prefers 256-bit vectors: the rigid f64 advance held 849 `<4 x double>`
+operations and none wider, so half of every register sat idle. No ti.init option sets the width, but LLVM's
+own command-line options live in Taichi's library, and `-force-vector-width=16` has the loop vectoriser take
+16 lanes in every loop it vectorises: a group of 16 f64 pendulums (System.CHUNK) in two 512-bit registers a
+value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance.md).
+
+No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
+what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0 and 16 lanes).
+
+LLVM's C entry point LLVMParseCommandLineOptions is in the library but not exported, so it is looked up in the
+library's ELF symbol table and called at its address. Where that cannot be done (no symbol table, another
+OS, LLVM targeting no AVX-512 CPU it knows), nothing changes. PENDULUM_VECTOR_WIDTH sets the width by hand
+(0 = LLVM's own choice), for measuring. A forced width also has LLVM print a remark for each loop it could
+not vectorise at it, which is dropped (_quiet_compiles).
+
+Taichi's offline cache keys a kernel by its source and Taichi's settings, not LLVM's options, so kernels
+compiled at a forced width are cached in a subfolder of their own: a cache filled at the other width is never
+taken for this one.
+"""
+from __future__ import annotations
+
+import ctypes
+import mmap
+import os
+import re
+import struct
+import weakref
+
+import numpy as np
+import taichi as ti  # maps the library this module reads
+
+from . import held_stderr
+from ..errors import SceneError
+
+# LLVM 15's CPUs with AVX-512 whose tuning has "prefer-256-bit" (llvm/lib/Target/X86/X86.td). AMD's Zen 4 is
+# not among them: LLVM 15 predates it and names it znver3, an AVX2 CPU, so Taichi compiles for AVX2 there.
+PREFER_256 = frozenset({"skylake-avx512", "cascadelake", "cooperlake", "cannonlake", "icelake-client",
+                        "icelake-server", "rocketlake", "tigerlake", "sapphirerapids"})
+# Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64;
+# 32 is more in f32 but leaves a 16-lane f64 loop to its scalar remainder (23M against 128M steps/s), and the
+# option is one for every loop of the process.
+WIDTH = 16
+ENV, WIDTHS = "PENDULUM_VECTOR_WIDTH", ("0", "1", "2", "4", "8", "16", "32", "64")  # LLVM takes powers of 2
+_SYM = np.dtype([("name", "<u4"), ("info", "u1"), ("other", "u1"), ("shndx", "<u2"), ("value", "<u8"),
+                 ("size", "<u8")])
+_done: int | None = None  # the width this process set (0: none); LLVM's options are parsed once per process
+
+
+def apply() -> int:
+    """Set the loop vectoriser's width for this process, once, before any kernel compiles; returns the width
+    set, 0 where LLVM keeps its own. Also points Taichi's offline cache at the width's own subfolder."""
+    global _done
+    if _done is None:
+        width, parse = _plan()
+        if width:
+            argv = [b"pendulum", f"-force-vector-width={width}".encode()]
+            parse(len(argv), (ctypes.c_char_p * len(argv))(*argv), b"")
+            _own_cache(f"llvm-vf{width}")
+            _quiet_compiles()
+        _done = width
+    return _done
+
+
+def planned() -> int:
+    """The width apply() sets, or set, in this process (0: LLVM's own), without setting it."""
+    return _done if _done is not None else _plan()[0]
+
+
+def _plan():
+    """(width, LLVMParseCommandLineOptions as a callable): the width PENDULUM_VECTOR_WIDTH asks for, else WIDTH
+    where LLVM targets a CPU of PREFER_256; (0, None) where it is LLVM's own or cannot be set."""
+    asked = os.environ.get(ENV, "").strip()
+    if asked and asked not in WIDTHS:
+        raise SceneError(f"${ENV}: {asked!r} is not a width: one of {', '.join(WIDTHS)} (0: LLVM's own)")
+    if asked == "0":
+        return 0, None
+    lib = _library()
+    names = ("LLVMParseCommandLineOptions", "_ZN4llvm3sys14getHostCPUNameEv", "PyInit_taichi_python")
+    syms = _symbols(lib, names) if lib else {}
+    if len(syms) < len(names):
+        return 0, None
+    so = ctypes.CDLL(lib)  # already loaded by taichi: the same handle, so the same load address
+    base = ctypes.cast(so.PyInit_taichi_python, ctypes.c_void_p).value - syms["PyInit_taichi_python"]
+    if not asked:
+        cpu = ctypes.CFUNCTYPE(_StringRef)(base + syms["_ZN4llvm3sys14getHostCPUNameEv"])()
+        if ctypes.string_at(cpu.data, cpu.size).decode() not in PREFER_256:
+            return 0, None
+    parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
+    return int(asked or WIDTH), parse(base + syms["LLVMParseCommandLineOptions"])
+
+
+class _StringRef(ctypes.Structure):  # llvm::StringRef, returned in two registers
+    _fields_ = [("data", ctypes.c_void_p), ("size", ctypes.c_size_t)]
+
+
+def _library() -> str | None:
+    """The path of Taichi's compiled library, as this process mapped it."""
+    try:
+        with open("/proc/self/maps") as maps:
+            for line in maps:
+                if "taichi_python" in line and line.rstrip().endswith(".so"):
+                    return line.split(maxsplit=5)[5].strip()
+    except OSError:
+        pass
+    return None
+
+
+def _symbols(path: str, names: tuple[str, ...]) -> dict[str, int]:
+    """{name: address relative to the load base} of the functions named, from a 64-bit little-endian ELF's
+    .symtab; a name absent or found more than once is left out."""
+    found = {}
+    with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as m:
+        if m[:6] != b"\x7fELF\x02\x01":
+            return found
+        shoff, = struct.unpack_from("<Q", m, 0x28)
+        shentsize, shnum = struct.unpack_from("<HH", m, 0x3A)
+        sections = [struct.unpack_from("<IIQQQQIIQQ", m, shoff + i * shentsize) for i in range(shnum)]
+        for _, kind, _, _, offset, size, link, _, _, _ in sections:
+            if kind != 2:  # SHT_SYMTAB
+                continue
+            str_at, str_size = sections[link][4], sections[link][5]
+            syms = np.frombuffer(m, _SYM, size // _SYM.itemsize, offset)
+            funcs = syms[(syms["info"] & 0xF) == 2]  # STT_FUNC
+            for name in names:
+                # a name may end another one in the string table, so every place it ends a string counts
+                key, starts = name.encode() + b"\0", []
+                at = m.find(key, str_at, str_at + str_size)
+                while at >= 0:
+                    starts.append(at - str_at)
+                    at = m.find(key, at + 1, str_at + str_size)
+                hit = funcs["value"][np.isin(funcs["name"], starts)]
+                if len(hit) == 1:
+                    found[name] = int(hit[0])
+            del syms, funcs  # the mmap cannot close while numpy holds a view of it
+    return found
+
+
+# A width asked for makes LLVM report every loop it could not vectorise at it, on stderr ("remark: <unknown>:0:0:
+# loop not vectorized: call instruction cannot be vectorized": Taichi's own runtime loops make several per
+# kernel); asked-for widths make it a remark that always prints, whatever LLVM's remark options say.
+_REMARK = re.compile(rb"^remark: [^\n]*loop not vectorized[^\n]*(\n|$)", re.M)
+
+
+def _quiet_compiles():
+    """Drop those remarks: LLVM runs when a kernel is first launched (compiled, or found in the offline cache)
+    and when fields are finalised, so fd 2 is held through those calls alone and what else was written there
+    is passed on."""
+    from taichi._snode.fields_builder import FieldsBuilder
+    from taichi.lang import kernel_impl
+
+    launch, finalize, launched = kernel_impl.Kernel.launch_kernel, FieldsBuilder.finalize, weakref.WeakSet()
+
+    def launch_kernel(self, t_kernel, *args):
+        if t_kernel in launched:
+            return launch(self, t_kernel, *args)
+        launched.add(t_kernel)
+        with held_stderr.held(_without_remarks):
+            return launch(self, t_kernel, *args)
+
+    def finalize_fields(self, *args, **kwargs):
+        with held_stderr.held(_without_remarks):
+            return finalize(self, *args, **kwargs)
+
+    kernel_impl.Kernel.launch_kernel, FieldsBuilder.finalize = launch_kernel, finalize_fields
+
+
+def _without_remarks(text: bytes, ok: bool) -> bytes:
+    return _REMARK.sub(b"", text)
+
+
+def _own_cache(sub: str):
+    """Point Taichi's offline cache (TI_OFFLINE_CACHE_FILE_PATH, else Taichi's default) at its subfolder sub;
+    a child process inherits the path and keeps it."""
+    path = os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path
+    if os.path.basename(os.path.normpath(path)) != sub:
+        os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = os.path.join(path, sub)
