@@ -41,7 +41,8 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
     kind = cpu_kind()
     rep = {"quick": quick, "wall_s": wall, "created": time.strftime("%Y-%m-%d %H:%M:%S"),
            "rounds": mpl["vs"]["render"]["rounds"],
-           "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind, "simd": simd_flags(),
+           "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind,
+                       "simd": vector_width.simd_flags(),
                        "vector_width": vector_width.planned(),  # the phases' processes set it so
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
@@ -103,18 +104,9 @@ def load_text(load) -> str:
     return " / ".join(f"{x:.2f}" for x in load) + " (1 / 5 / 15 min)"
 
 
-def simd_flags() -> list[str]:
-    """The CPU's vector extensions that matter here, from /proc/cpuinfo (Linux; empty elsewhere)."""
-    try:
-        flags = next(x.split(":", 1)[1].split() for x in open("/proc/cpuinfo") if x.startswith("flags"))
-    except (OSError, StopIteration):
-        return []
-    return [f for f in ("avx2", "fma", "avx512f") if f in flags]
-
-
 def cpu_kind() -> str:
     """"avx512" or "avx2" (also for a CPU with neither): the kind the targets are chosen by."""
-    return "avx512" if "avx512f" in simd_flags() else "avx2"
+    return "avx512" if "avx512f" in vector_width.simd_flags() else "avx2"
 
 
 def cpu_model() -> str:

@@ -75,7 +75,7 @@ def _plan():
     asked = os.environ.get(ENV, "").strip()
     if asked and asked not in WIDTHS:
         raise SceneError(f"${ENV}: {asked!r} is not a width: one of {', '.join(WIDTHS)} (0: LLVM's own)")
-    if asked == "0":
+    if asked == "0" or not (asked or "avx512f" in simd_flags()):  # no AVX-512: nothing to look up
         return 0, None
     lib = _library()
     names = ("LLVMParseCommandLineOptions", "_ZN4llvm3sys14getHostCPUNameEv", "PyInit_taichi_python")
@@ -90,6 +90,15 @@ def _plan():
             return 0, None
     parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
     return int(asked or WIDTH), parse(base + syms["LLVMParseCommandLineOptions"])
+
+
+def simd_flags() -> list[str]:
+    """The CPU's vector extensions that matter here, from /proc/cpuinfo (Linux; empty elsewhere)."""
+    try:
+        flags = next(x.split(":", 1)[1].split() for x in open("/proc/cpuinfo") if x.startswith("flags"))
+    except (OSError, StopIteration):
+        return []
+    return [f for f in ("avx2", "fma", "avx512f") if f in flags]
 
 
 class _StringRef(ctypes.Structure):  # llvm::StringRef, returned in two registers
