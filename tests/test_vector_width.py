@@ -101,8 +101,9 @@ def test_width_zero_sets_nothing_and_keeps_the_cache(tmp_path):
 
 def test_a_width_that_is_not_one_exits_2_with_one_line_and_writes_nothing(tmp_path):
     env = dict(os.environ, PENDULUM_VECTOR_WIDTH="12")
-    r = run_cli("render", "rigid_chaos", "--out", tmp_path / "out", "--set", "video.duration=0.2", env=env)
-    assert r.returncode == 2, r.stderr
-    assert r.stderr.strip() == ("pendulum: error: $PENDULUM_VECTOR_WIDTH: '12' is not a width: one of 0, 1, 2, 4, "
-                                "8, 16, 32, 64 (0: LLVM's own)")
-    assert not (tmp_path / "out").exists()
+    for command in (["render", "rigid_chaos", "--set", "video.duration=0.2"], ["bench", "--quick"]):
+        r = run_cli(*command, "--out", tmp_path / "out", env=env)
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.strip() == ("pendulum: error: $PENDULUM_VECTOR_WIDTH: '12' is not a width: one of 0, 1, 2, "
+                                    "4, 8, 16, 32, 64 (0: LLVM's own)")
+        assert not (tmp_path / "out").exists()

@@ -28,6 +28,7 @@ from .bench_sim import phase_sim
 from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
 from ..video.atomic import write_atomic
 from ..config.options import check_writable, positive_int
+from ..physics import vector_width
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
 FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fractal_divergence",
@@ -77,8 +78,10 @@ def run(args) -> int:
         args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
         return 0
     check_writable(args.out)
+    width = vector_width.planned()  # a bad $PENDULUM_VECTOR_WIDTH stops the bench here, not in its first phase
     load = os.getloadavg()  # other work on the machine skews every figure: the report says how much
-    print(f"bench: load average {load_text(load)} at the start, {cpu_kind()} CPU", file=sys.stderr)
+    print(f"bench: load average {load_text(load)} at the start, {cpu_kind()} CPU, "
+          f"{width_text({'vector_width': width})}", file=sys.stderr)
     t0, res = time.perf_counter(), {}
     with tempfile.TemporaryDirectory(prefix="pendulum-bench-") as tmp:
         for name in PHASES:
