@@ -118,36 +118,50 @@ def chaos_scene(cfg):
 
 
 def phase_encode(cfg, arch, tmp) -> dict:
-    """Draw rigid_chaos's frames into a raw file (timing simulate and draw), then time only the encoding of
-    those frames (memory-mapped) through the same Encoder: the floor an end-to-end render cannot beat."""
-    from ..physics.stepper import Run
-    from ..draw.canvas import Canvas
+    """Record rigid_chaos's frames as a render makes them (pipeline.Source, and the GIF's own smaller frames
+    from gif.Frames), timing simulate and draw, then time only the encoding of those frames (memory-mapped)
+    through the same Encoder: the floor an end-to-end render cannot beat. Until 2026-12-04 the floor fed the GIF
+    the video's frames, which the Encoder then area-averaged in numpy (3.1 s of this process's CPU beside the
+    encoders on the 2-core Xeon): work no render does, so the floor was higher than the encoders alone."""
+    from ..video import pipeline
     from ..video.encode import Encoder
+    from ..video.gif import Frames
 
     scene = chaos_scene(cfg)
-    run = Run(scene, arch)
-    sim = run.sim
-    canvas, raw, timings, draw = Canvas(scene, sim), tmp / "frames.raw", {"simulate": 0.0}, 0.0
-    with open(raw, "wb") as fh:
-        for f in run.frames(timings=timings):
+    src = pipeline.Source(scene, arch)
+    scene, v = src.scene, src.scene.video
+    small = Frames(src, v, {"draw": 0.0}) if "gif" in v.formats else None
+    raw, raw_small, kept, draw, simulate = tmp / "frames.raw", tmp / "gif.raw", [], 0.0, 0.0
+    with open(raw, "wb") as fh, open(raw_small, "wb") as fs:
+        for f in range(scene.frames):
             if f == 2:  # frames 0 and 1 instantiate the kernels; time the steady state
-                timings["simulate"], draw = 0.0, 0.0
-            t = time.perf_counter()
-            frame = canvas.draw()
-            draw += time.perf_counter() - t
+                draw, simulate = 0.0, src.timings["simulate"]
+            d0 = src.timings["draw"]
+            frame = src.next_frame()
+            draw += src.timings["draw"] - d0
             fh.write(memoryview(frame).cast("B"))
-    v, n = scene.video, scene.frames - 2
+            gif_frame = small.frame(f, frame) if small else None
+            if gif_frame is not None:
+                kept.append(f)
+                fs.write(memoryview(np.ascontiguousarray(gif_frame)).cast("B"))
+    simulate = src.timings["simulate"] - simulate
+    n = scene.frames - 2
     frames = np.memmap(raw, np.uint8, "r", shape=(scene.frames, v.height, v.width, 3))
+    gif_frames = None
+    if kept:
+        gw, gh = small.w, small.h
+        gif_frames = dict(zip(kept, np.memmap(raw_small, np.uint8, "r", shape=(len(kept), gh, gw, 3))))
     (tmp / "floor").mkdir(exist_ok=True)
     t = time.perf_counter()
     enc = Encoder(tmp / "floor", scene.name, v, scene.frames)
     for f in range(scene.frames):
-        enc.write(frames[f])
+        enc.write(frames[f], gif_frames.get(f) if gif_frames else None)
     enc.close()
     floor = time.perf_counter() - t
-    del frames
+    del frames, gif_frames
     raw.unlink()
-    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + timings["simulate"]), "floor_s": floor,
+    raw_small.unlink()
+    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + simulate), "floor_s": floor,
             "encode_fps": scene.frames / floor}
 
 
