@@ -153,7 +153,7 @@ def phase_encode(cfg, arch, tmp) -> dict:
         gif_frames = dict(zip(kept, np.memmap(raw_small, np.uint8, "r", shape=(len(kept), gh, gw, 3))))
     (tmp / "floor").mkdir(exist_ok=True)
     t = time.perf_counter()
-    enc = Encoder(tmp / "floor", scene.name, v, scene.frames)
+    enc = Encoder(tmp / "floor", scene.name, v, scene.frames, planar=True)
     for f in range(scene.frames):
         enc.write(frames[f], gif_frames.get(f) if gif_frames else None)
     enc.close()

@@ -116,6 +116,11 @@ def os_error(log: str) -> int | None:
     return min(found)[1] if found else None
 
 
+def yuv_fits(w: int, h: int) -> bool:
+    """Whether render/video/yuv.py converts frames of w×h: rows of RGB in whole 4-byte words, whole 2×2 blocks."""
+    return w % 4 == 0 and h % 2 == 0
+
+
 class _Still:
     """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
 
@@ -134,8 +139,9 @@ class _Target:
     """One ffmpeg process, the thread that feeds it, and where its output goes."""
 
     def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None,
-                 small: tuple[int, int] | None = None):
+                 small: tuple[int, int] | None = None, planar: bool = False):
         self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
+        self.planar = planar  # fed yuv420p (render/video/yuv.py), not rgb24
         self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
         self.small = small  # the GIF's (width, height): it is fed frames of that size only
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
@@ -166,7 +172,13 @@ class _Target:
 class Encoder:
     """Writes `frames` to out_dir/NAME.<fmt> for each format: write() each frame, then close(), or abort()."""
 
-    def __init__(self, out_dir: Path, name: str, video, frames: int, formats=None):
+    def __init__(self, out_dir: Path, name: str, video, frames: int, formats=None, planar: bool = False):
+        """planar: convert the MP4's frames to yuv420p before its pipe, in a Taichi kernel (render/video/yuv.py),
+        which needs the Taichi a Run started; else ffmpeg converts the rgb24 it is fed."""
+        self.yuv = None
+        if planar and yuv_fits(video.width, video.height):
+            from . import yuv  # Taichi: not for a plan (render/config/budget.py reads this module)
+            self.yuv = yuv
         self.targets: list[_Target] = []
         self.written = 0
         self.stills: list[_Still] = []
@@ -181,7 +193,9 @@ class Encoder:
                 tmp = temp_beside(final, suffix=".part")
                 log = tempfile.TemporaryFile()
                 rate, (w, h) = (gif.rate(video), gif.size(video)) if fmt == "gif" else (video.fps, self.size)
-                cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+                planar = fmt == "mp4" and self.yuv is not None
+                cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo",
+                       "-pix_fmt", "yuv420p" if planar else "rgb24",
                        "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-an",
                        *ARGS[fmt](video), tmp]
                 try:
@@ -192,7 +206,7 @@ class Encoder:
                     log.close()
                     raise
                 self.targets.append(_Target(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif"
-                                            else None, gif.size(video) if fmt == "gif" else None))
+                                            else None, gif.size(video) if fmt == "gif" else None, planar))
         except BaseException:
             self.abort()
             raise
@@ -211,6 +225,7 @@ class Encoder:
                 except subprocess.TimeoutExpired:
                     pass
                 raise self._failure("stopped", t.error)
+        planar = self.yuv.convert(frame) if any(t.planar for t in self.targets) else None
         for t in self.targets:
             n = 1 if t.repeats is None else t.repeats[self.written]
             if n and t.small is not None:
@@ -218,7 +233,7 @@ class Encoder:
                 if mine.shape != (t.small[1], t.small[0], 3):
                     raise ValueError(f"a GIF frame of {mine.shape[1]}x{mine.shape[0]}, not {t.small[0]}x{t.small[1]}")
             for _ in range(n):
-                t.queue.put(frame if t.small is None else mine)
+                t.queue.put(planar if t.planar else frame if t.small is None else mine)
         self.written += 1
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept

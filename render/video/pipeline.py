@@ -176,7 +176,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     if audio.heard(scene):  # the `audio` effect: the fan's angles at every frame make the MP4's track
         voices = audio.Voices(src.sim, scene.video.fps)
     with output_dir(scene.out_dir(out_root)) as out_dir:
-        enc = Encoder(out_dir, scene.name, scene.video, scene.frames)
+        enc = Encoder(out_dir, scene.name, scene.video, scene.frames, planar=True)
         small = Frames(src, scene.video, timings) if "gif" in scene.video.formats else None  # the GIF's own
         # A GIF alone with a canvas of its own needs no frame of the video's size: 720p frames drawn for nothing
         # were half of a GIF-only rigid_chaos render (28.4 s, 14.8 s without them).
