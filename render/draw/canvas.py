@@ -1,8 +1,8 @@
 """An offscreen canvas: Taichi kernels that draw each frame straight into a numpy uint8 array.
 
-Its primitives (render/draw/raster.py) are composited with a max per channel (atomic where they are drawn
-in parallel), which does not depend on drawing order, so frames are byte-identical across runs and thread
-counts. Each effect has its own kernel, launched (and compiled) only when the scene calls for it. The
+Its primitives (render/draw/raster.py) are composited with a max per channel, which does not depend on
+drawing order, so frames are byte-identical across runs and thread counts. On the CPU each thread draws every
+primitive into a band of rows of its own, so no pixel has two writers and the max needs no atomic. Each effect has its own kernel, launched (and compiled) only when the scene calls for it. The
 pendulums' view (render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and
 of what the caller draws over the frame (keep_clear).
 
@@ -21,10 +21,12 @@ from .raster import COILS, Raster
 
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
-# On a CPU with at most this many threads, primitives are drawn by one thread with a plain max instead of
-# an atomic one: a float atomic max is a compare-exchange loop, about 2/3 of the drawing time, so one
-# thread without it beats two with it (rigid_chaos, 720p: rods+bobs 1.1 ms vs 2.9 ms of CPU per frame).
-SERIAL_MAX_THREADS = 4
+# The primitive kernels' loop on the CPU: a band of rows per thread, each band's work in the first of BAND_SLOTS
+# iterations, since Taichi's CPU threads take a parallel loop in blocks of at least 512 (render/physics/runtime.py).
+# A float atomic max is a compare-exchange loop, about 2/3 of the drawing time (rigid_chaos, 720p: rods+bobs
+# 1.1 ms of CPU a frame serial, 2.9 ms on two threads with it), so bands, whose pixels no other thread writes,
+# beat pendulums shared out with atomics.
+BAND_SLOTS = 512
 
 
 @ti.func
@@ -57,7 +59,11 @@ class Canvas(Raster, runtime.Launcher):
             light = ti.i32
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
-        self.serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_MAX_THREADS
+        self.banded = cfg.arch != ti.cuda  # else (CUDA) one pendulum per loop iteration, the max atomic
+        self.bands = max(1, cfg.cpu_max_num_threads) if self.banded else 1
+        self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
+        self.slots = self.bands * BAND_SLOTS if self.banded else self.n
+        self.serial = self.banded and cfg.cpu_max_num_threads <= 4  # bob_pixels: few points, one thread is cheaper
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
         self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, TILE)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
@@ -191,50 +197,70 @@ class Canvas(Raster, runtime.Launcher):
         for i in range(self.n):
             self.path[slot, i] = self.pixel(self.sim.points(self.sim.q[i]), self.tip)
 
+    @ti.func
+    def slot(self, s):
+        """What iteration s of a primitive kernel's loop draws: pendulums lo <= i < hi, clipped to rows
+        y0 <= y < y1, as (lo, hi, y0, y1). CPU: the first slot of each band draws every pendulum into that
+        band; CUDA: slot s is pendulum s, the whole frame."""
+        out = ti.Vector([s, s + 1, 0, self.h])
+        if ti.static(self.banded):
+            band = s // BAND_SLOTS
+            y0 = band * self.band_rows
+            out = ti.Vector([0, 0, y0, ti.min(self.h, y0 + self.band_rows)])
+            if s % BAND_SLOTS == 0:
+                out[1] = self.n
+        return out
+
     @ti.kernel
     def stamp_trails(self, first: ti.i32, skipped: ti.i32):
         """The outer bob's path since the last frame into the trail layer (compose_frame fades it): through
         the points of the `skipped` frames before this one (follow()), then to where it is now."""
-        ti.loop_config(serialize=self.serial)
-        for i in range(self.n):
-            p = self.pos[i, self.tip]  # the last bob leaves the trail
-            a = p if first else self.last[i]
-            c = self.ink(i, 0.9, 0.0) * self.trail_light
-            for s in range(skipped + 1):  # one call of segment(), which is inlined: half the code to compile
-                b = p
-                if ti.static(self.follows):
-                    if s < skipped:
-                        b = self.path[s, i]
-                self.segment(self.trail, self.lit, a, b, self.lw, c, True)
-                a = b
-            self.last[i] = p
+        for s in range(self.slots):
+            w = self.slot(s)
+            for i in range(w[0], w[1]):
+                p = self.pos[i, self.tip]  # the last bob leaves the trail
+                a = p if first else self.last[i]
+                c = self.ink(i, 0.9, 0.0) * self.trail_light
+                for k in range(skipped + 1):  # one call of segment(), which is inlined: half the code to compile
+                    b = p
+                    if ti.static(self.follows):
+                        if k < skipped:
+                            b = self.path[k, i]
+                    self.segment(self.trail, self.lit, a, b, self.lw, c, w[2], w[3], True)
+                    a = b
+        for i in range(self.n):  # after every band has read where the bob was
+            self.last[i] = self.pos[i, self.tip]
 
     @ti.kernel
     def draw_rods(self):
-        ti.loop_config(serialize=self.serial)
-        for i in range(self.n):
-            for j in ti.static(range(len(self.links))):
-                if ti.static(self.links[j] == "rod"):
-                    self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
-                                 self.ink(i, 0.55, 0.15))
+        for s in range(self.slots):
+            w = self.slot(s)
+            for i in range(w[0], w[1]):
+                for j in ti.static(range(len(self.links))):
+                    if ti.static(self.links[j] == "rod"):
+                        self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
+                                     self.ink(i, 0.55, 0.15), w[2], w[3])
 
     @ti.kernel
     def draw_spring_coils(self):
-        ti.loop_config(serialize=self.serial)
-        for i, k in ti.ndrange(self.n, COILS + 2):
-            for j in ti.static(range(len(self.links))):
-                if ti.static(self.links[j] == "spring"):
-                    a, b = self.joint(i, j), self.pos[i, j]
-                    self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
-                                 self.lw, self.ink(i, 0.55, 0.15))
+        for s in range(self.slots):
+            w = self.slot(s)
+            for i in range(w[0], w[1]):
+                for k in range(COILS + 2):
+                    for j in ti.static(range(len(self.links))):
+                        if ti.static(self.links[j] == "spring"):
+                            a, b = self.joint(i, j), self.pos[i, j]
+                            self.segment(self.rgb, self.drawn, self.coil_node(a, b, k),
+                                         self.coil_node(a, b, k + 1), self.lw, self.ink(i, 0.55, 0.15), w[2], w[3])
 
     @ti.kernel
     def draw_bobs(self):
-        ti.loop_config(serialize=self.serial)
-        for i in range(self.n):
-            for j in ti.static(range(len(self.links))):
-                self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0))
-        self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]))
+        for s in range(self.slots):
+            w = self.slot(s)
+            for i in range(w[0], w[1]):
+                for j in ti.static(range(len(self.links))):
+                    self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0), w[2], w[3])
+        self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]), 0, self.h)
 
     @ti.kernel
     def compose_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):

@@ -61,13 +61,15 @@ class Glow:
             ti.atomic_add(buf[y, x][k], ti.cast(c[k] * FIX + 0.5, ti.i32))
 
     @ti.func
-    def segment(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), a, b, c, flat: ti.template()):
+    def segment(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), a, b, c, flat: ti.template(),
+                y0, y1):
         """A hairline from a to b (pixels) into canvas cv's layer `buf`: Xiaolin Wu's antialiased line, two
         pixels per column of its major axis, split by where the line crosses the column, and as much light
         per unit of length whatever its slope. Under glow lines are thin by design (the max canvas's
         half-width does not apply): 1000 pendulums draw 2000 rods of up to 160 px a frame, and this is 3.5x
         cheaper than the max canvas's coverage from the distance to the segment (14 -> 4 ms a frame).
-        `flat`: the columns of [a, b), half-open, so consecutive segments of a trail share none."""
+        `flat`: the columns of [a, b), half-open, so consecutive segments of a trail share none. Only rows
+        y0 <= y < y1 are lit (a thread's band: render/draw/raster.py)."""
         swap = ti.abs(b[1] - a[1]) > ti.abs(b[0] - a[0])
         if swap:
             a, b = ti.Vector([a[1], a[0]]), ti.Vector([b[1], b[0]])
@@ -83,20 +85,22 @@ class Glow:
                 first += 1
             elif not flipped and last == b[0]:
                 last -= 1
+        if swap:  # the major axis is y
+            first, last = ti.max(first, y0), ti.min(last, y1 - 1)
         for u in range(first, last + 1):
             y = a[1] + slope * (u - a[0])
             v = int(ti.floor(y))
             f = y - v
-            self.hair(cv, buf, tiles, u, v, swap, light * (1.0 - f))
-            self.hair(cv, buf, tiles, u, v + 1, swap, light * f)
+            self.hair(cv, buf, tiles, u, v, swap, light * (1.0 - f), y0, y1)
+            self.hair(cv, buf, tiles, u, v + 1, swap, light * f, y0, y1)
 
     @ti.func
-    def hair(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), u, v, swap, light):
-        """Fixed-point light at (u, v) of the major axis walk (swapped back to x, y)."""
+    def hair(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), u, v, swap, light, y0, y1):
+        """Fixed-point light at (u, v) of the major axis walk (swapped back to x, y), if y0 <= y < y1."""
         y, x = v, u
         if swap:
             y, x = u, v
-        if 0 <= x < cv.w and 0 <= y < cv.h:
+        if 0 <= x < cv.w and y0 <= y < y1:
             for k in ti.static(range(3)):
                 ti.atomic_add(buf[y, x][k], ti.cast(light[k] + 0.5, ti.i32))
             tiles[y // cv.TILE, x // cv.TILE] = 1

@@ -5,9 +5,11 @@ join.
 Apart from render/draw/canvas.py, which owns the layers, the view and the kernels that call these: how a shape
 becomes pixels is one idea, what a frame draws and how it is composed another. Raster is a mixin of Taichi
 functions the Canvas inherits; they read only its size (w, h, n, TILE), palette and compositing (rainbow,
-glowing, gain, glow, serial), coil amplitude (amp) and layer of bobs (rgb, drawn). Coverage comes from the
-distance to each segment or circle; a primitive is composed with a max per channel (atomic where drawn in
-parallel), which does not depend on drawing order, or under glow is added as light (render/draw/glow.py).
+glowing, gain, glow, banded), coil amplitude (amp) and layer of bobs (rgb, drawn). Coverage comes from the
+distance to each segment or circle; a primitive is composed with a max per channel, which does not depend on
+drawing order, or under glow is added as light (render/draw/glow.py). Every primitive is clipped to a band of
+rows [y0, y1): on the CPU each thread draws every primitive into its own band (render/draw/canvas.py), so no
+two threads write one pixel and the max needs no atomic; on CUDA the band is the frame and the max is atomic.
 """
 import taichi as ti
 
@@ -47,29 +49,32 @@ class Raster:
         return c
 
     @ti.func
-    def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c):
-        if 0 <= x < self.w and 0 <= y < self.h:
+    def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c, y0, y1):
+        if 0 <= x < self.w and y0 <= y < y1:
             if ti.static(self.glowing):
                 self.glow.deposit(buf, y, x, c)
             for k in ti.static(range(3) if not self.glowing else ()):
-                if ti.static(self.serial):
+                if ti.static(self.banded):
                     buf[y, x][k] = ti.max(buf[y, x][k], c[k])
                 else:
                     ti.atomic_max(buf[y, x][k], c[k])
             tiles[y // self.TILE, x // self.TILE] = 1  # every writer stores the same 1: the race is harmless
 
     @ti.func
-    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, flat: ti.template() = False):
-        """A line from a to b (x, y in pixels): under glow a hairline of light (render/draw/glow.py; `flat`: a
-        trail's pieces, which must not overlap), else antialiased with half-width r."""
-        if ti.static(self.glowing):
-            self.glow.segment(self, buf, tiles, a, b, c, flat)
-        else:
-            self.max_segment(buf, tiles, a, b, r, c)
+    def segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, y0, y1, flat: ti.template() = False):
+        """A line from a to b (x, y in pixels), its rows y0 <= y < y1: under glow a hairline of light
+        (render/draw/glow.py; `flat`: a trail's pieces, which must not overlap), else antialiased with
+        half-width r. A band the line's pixels cannot reach is not walked."""
+        if ti.min(a[1], b[1]) - r - 2.0 < y1 and ti.max(a[1], b[1]) + r + 2.0 >= y0:
+            if ti.static(self.glowing):
+                self.glow.segment(self, buf, tiles, a, b, c, flat, y0, y1)
+            else:
+                self.max_segment(buf, tiles, a, b, r, c, y0, y1)
 
     @ti.func
-    def max_segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c):
-        """Antialiased segment of half-width r, walked along its major axis, composed with a max."""
+    def max_segment(self, buf: ti.template(), tiles: ti.template(), a, b, r, c, y0, y1):
+        """Antialiased segment of half-width r, walked along its major axis, composed with a max; only the
+        walk's rows in [y0, y1) are visited (the coverage of each pixel is the same as unclipped)."""
         swap = ti.abs(b[1] - a[1]) > ti.abs(b[0] - a[0])
         if swap:
             a, b = ti.Vector([a[1], a[0]]), ti.Vector([b[1], b[0]])
@@ -82,26 +87,32 @@ class Raster:
         # the minor axis (end caps included); the old fixed band of ±reach is kept as an outer bound.
         band = (r + 0.5) * ti.sqrt(1.0 + slope * slope) + 0.01
         ll = ti.max(d.norm_sqr(), 1e-12)
-        for u in range(int(ti.floor(a[0] - r - 1.0)), int(ti.ceil(b[0] + r + 1.0)) + 1):
+        first, last = int(ti.floor(a[0] - r - 1.0)), int(ti.ceil(b[0] + r + 1.0))
+        if swap:  # the major axis is y
+            first, last = ti.max(first, y0), ti.min(last, y1 - 1)
+        for u in range(first, last + 1):
             vl = a[1] + slope * (ti.min(ti.max(u, a[0]), b[0]) - a[0])
             vc = int(ti.round(vl))
             lo, hi = ti.max(vc - reach, int(ti.ceil(vl - band))), ti.min(vc + reach, int(ti.floor(vl + band)))
+            if not swap:
+                lo, hi = ti.max(lo, y0), ti.min(hi, y1 - 1)
             for v in range(lo, hi + 1):
                 p = ti.Vector([ti.cast(u, ti.f32), ti.cast(v, ti.f32)])
                 t = ti.min(ti.max((p - a).dot(d) / ll, 0.0), 1.0)
                 cov = ti.min(ti.max(r + 0.5 - (p - a - t * d).norm(), 0.0), 1.0)
                 if cov > 0.0:
                     if swap:
-                        self.plot(buf, tiles, u, v, c * cov)
+                        self.plot(buf, tiles, u, v, c * cov, y0, y1)
                     else:
-                        self.plot(buf, tiles, v, u, c * cov)
+                        self.plot(buf, tiles, v, u, c * cov, y0, y1)
 
     @ti.func
-    def disc(self, centre, r, c):
+    def disc(self, centre, r, c, y0, y1):
+        """A disc of radius r into the layer of bobs, its rows y0 <= y < y1."""
         reach = int(r) + 2
         cx, cy = int(ti.round(centre[0])), int(ti.round(centre[1]))
         rr = (r + 0.5) * (r + 0.5)
-        for y in range(cy - reach, cy + reach + 1):
+        for y in range(ti.max(cy - reach, y0), ti.min(cy + reach, y1 - 1) + 1):
             dy = ti.cast(y, ti.f32) - centre[1]
             if dy * dy < rr:  # only the columns a row of the disc covers (with a hair of margin)
                 half = ti.sqrt(rr - dy * dy) + 0.01
@@ -110,7 +121,7 @@ class Raster:
                     dist = (ti.Vector([ti.cast(x, ti.f32), ti.cast(y, ti.f32)]) - centre).norm()
                     cov = ti.min(ti.max(r + 0.5 - dist, 0.0), 1.0)
                     if cov > 0.0:
-                        self.plot(self.rgb, self.drawn, y, x, c * cov)
+                        self.plot(self.rgb, self.drawn, y, x, c * cov, y0, y1)
 
     @ti.func
     def coil_node(self, a, b, k):
