@@ -7,10 +7,13 @@ Lines are antialiased hairlines (segment()), as much light per unit of length at
 canvas's discs. The layers are stored tile by tile (runtime.field's block), where row-major order would miss
 the cache at every pixel of a steep line.
 
-Determinism: light is accumulated in fixed point (FIX per unit) with integer atomic adds. Integer addition
-is associative, so the sum per pixel, and the frame, is the same bytes whatever the order of the adds and
-the number of threads (float atomics in racing order would not be). Each contribution is rounded on its
-own, before it is added, so it does not depend on the order either.
+Determinism: light is accumulated in fixed point (FIX per unit) with integer adds. Integer addition is
+associative, so the sum per pixel, and the frame, is the same bytes whatever the order of the adds and the
+number of threads (float adds in racing order would not be). Each contribution is rounded on its own, before
+it is added, so it does not depend on the order either. On the CPU each thread draws its own band of rows
+(render/draw/canvas.py), so the adds are plain; on CUDA they are atomic. An atomic add in a parallel loop
+stays a locked instruction even with one thread: rainbow_1000's rods took 8.6 ms a frame with them, and
+Taichi had turned them into plain adds only in the serial loop the bands replaced.
 
 Tone map: byte = 255·(1 − exp(−light)), from a table indexed by light in steps of 1/512 (4096 entries, up
 to a light of 8, where it is white). It is smooth near black, so a single faint pendulum stays visible, and
@@ -47,6 +50,15 @@ def tone_table() -> np.ndarray:
     return np.floor(255.0 * (1.0 - np.exp(-light)) + 0.5).astype(np.int32)
 
 
+@ti.func
+def add(cell: ti.template(), v, plain: ti.template()):
+    """cell += v, plainly where no other thread writes the cell (`+=` on a field is an atomic add in Taichi)."""
+    if ti.static(plain):
+        cell = cell + v
+    else:
+        ti.atomic_add(cell, v)
+
+
 @ti.data_oriented
 class Glow:
     def __init__(self, decay: float):
@@ -55,10 +67,11 @@ class Glow:
         self.decay = int(round(decay * (1 << DECAY_BITS)))
 
     @ti.func
-    def deposit(self, buf: ti.template(), y, x, c):
-        """Add light c (f32, in units of 1) at a pixel, rounded to fixed point first."""
+    def deposit(self, buf: ti.template(), y, x, c, plain: ti.template()):
+        """Add light c (f32, in units of 1) at a pixel, rounded to fixed point first; `plain`: no other thread
+        writes the pixel (a band of rows of its own)."""
         for k in ti.static(range(3)):
-            ti.atomic_add(buf[y, x][k], ti.cast(c[k] * FIX + 0.5, ti.i32))
+            add(buf[y, x][k], ti.cast(c[k] * FIX + 0.5, ti.i32), plain)
 
     @ti.func
     def segment(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), a, b, c, flat: ti.template(),
@@ -102,7 +115,7 @@ class Glow:
             y, x = u, v
         if 0 <= x < cv.w and y0 <= y < y1:
             for k in ti.static(range(3)):
-                ti.atomic_add(buf[y, x][k], ti.cast(light[k] + 0.5, ti.i32))
+                add(buf[y, x][k], ti.cast(light[k] + 0.5, ti.i32), cv.banded)
             tiles[y // cv.TILE, x // cv.TILE] = 1
 
     @ti.func

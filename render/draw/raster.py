@@ -52,7 +52,7 @@ class Raster:
     def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c, y0, y1):
         if 0 <= x < self.w and y0 <= y < y1:
             if ti.static(self.glowing):
-                self.glow.deposit(buf, y, x, c)
+                self.glow.deposit(buf, y, x, c, self.banded)
             for k in ti.static(range(3) if not self.glowing else ()):
                 if ti.static(self.banded):
                     buf[y, x][k] = ti.max(buf[y, x][k], c[k])
