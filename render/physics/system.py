@@ -221,6 +221,15 @@ class System(Plan, runtime.Launcher):
         if not ti.abs(d) < 1e30:
             ti.atomic_min(self.bad[None], i)
 
+    @ti.kernel
+    def q_into(self, out: ti.types.ndarray(dtype=ti.f64, ndim=3), f: ti.i32):
+        """q into out[f] of an (frames, N, D) float64 array: what q.to_numpy() reads, without a new array and a
+        copy every frame. A read-out, like to_numpy, so not in the log of kernels (runtime.Launcher)."""
+        ti.loop_config(serialize=True)  # a certificate's subsample or lattice: fewer than waking threads costs
+        for i in range(self.n):
+            for d in ti.static(range(self.D)):
+                out[f, i, d] = ti.cast(self.q[i][d], ti.f64)
+
     # --------------------------------------------------------------- host side (for render/physics/stepper.py)
     def measure_energy(self, first: bool = False):
         """Energies at this frame into self.e, and the max relative drift so far into self.drift."""
