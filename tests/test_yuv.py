@@ -69,11 +69,11 @@ def test_luma_is_ffmpegs_own():
     assert np.abs(yuv.convert(f)[:n].astype(int) - theirs[:n]).max() <= 1
 
 
-@pytest.mark.parametrize("w,planar", [(64, True), (66, True), (64, False)])  # 66: not yuv_fits(), ffmpeg converts
+@pytest.mark.parametrize("w,planar", [(64, True), (66, True), (64, False)])  # 66: not yuv.fits(), ffmpeg converts
 def test_mp4_decodes_back(tmp_path, w, planar):
     h, n = 36, 12
     v = types.SimpleNamespace(fps=30, gif_fps=20, width=w, height=h, gif_width=32, formats=("mp4",), palette="fan")
-    assert encode.yuv_fits(w, h) == (w % 4 == 0)
+    assert yuv.fits(w, h) == (w % 4 == 0)
     frames = [np.roll(np.kron(frame(w // 2, h // 2, 4), np.ones((2, 2, 1), np.uint8)), 2 * i, axis=1)
               for i in range(n)]
     enc = encode.Encoder(tmp_path, "x", v, n, planar=planar)

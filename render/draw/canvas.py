@@ -17,16 +17,10 @@ import taichi as ti
 
 from ..physics import runtime
 from . import framing
-from .raster import COILS, Raster
+from .raster import BAND_SLOTS, COILS, Raster
 
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
-# The primitive kernels' loop on the CPU: a band of rows per thread, each band's work in the first of BAND_SLOTS
-# iterations, since Taichi's CPU threads take a parallel loop in blocks of at least 512 (render/physics/runtime.py).
-# A float atomic max is a compare-exchange loop, about 2/3 of the drawing time (rigid_chaos, 720p: rods+bobs
-# 1.1 ms of CPU a frame serial, 2.9 ms on two threads with it), so bands, whose pixels no other thread writes,
-# beat pendulums shared out with atomics.
-BAND_SLOTS = 512
 
 
 @ti.func
@@ -196,20 +190,6 @@ class Canvas(Raster, runtime.Launcher):
         ti.loop_config(serialize=self.serial)
         for i in range(self.n):
             self.path[slot, i] = self.pixel(self.sim.points(self.sim.q[i]), self.tip)
-
-    @ti.func
-    def slot(self, s):
-        """What iteration s of a primitive kernel's loop draws: pendulums lo <= i < hi, clipped to rows
-        y0 <= y < y1, as (lo, hi, y0, y1). CPU: the first slot of each band draws every pendulum into that
-        band; CUDA: slot s is pendulum s, the whole frame."""
-        out = ti.Vector([s, s + 1, 0, self.h])
-        if ti.static(self.banded):
-            band = s // BAND_SLOTS
-            y0 = band * self.band_rows
-            out = ti.Vector([0, 0, y0, ti.min(self.h, y0 + self.band_rows)])
-            if s % BAND_SLOTS == 0:
-                out[1] = self.n
-        return out
 
     @ti.kernel
     def stamp_trails(self, first: ti.i32, skipped: ti.i32):

@@ -5,8 +5,8 @@ join.
 Apart from render/draw/canvas.py, which owns the layers, the view and the kernels that call these: how a shape
 becomes pixels is one idea, what a frame draws and how it is composed another. Raster is a mixin of Taichi
 functions the Canvas inherits; they read only its size (w, h, n, TILE), palette and compositing (rainbow,
-glowing, gain, glow, banded), coil amplitude (amp) and layer of bobs (rgb, drawn). Coverage comes from the
-distance to each segment or circle; a primitive is composed with a max per channel, which does not depend on
+glowing, gain, glow), bands of rows (banded, band_rows), coil amplitude (amp) and layer of bobs (rgb, drawn).
+Coverage comes from the distance to each segment or circle; a primitive is composed with a max per channel, which does not depend on
 drawing order, or under glow is added as light (render/draw/glow.py). Every primitive is clipped to a band of
 rows [y0, y1): on the CPU each thread draws every primitive into its own band (render/draw/canvas.py), so no
 two threads write one pixel and the max needs no atomic; on CUDA the band is the frame and the max is atomic.
@@ -15,6 +15,12 @@ import taichi as ti
 
 COILS = 14  # zig-zag segments per spring
 LEAD = 0.12  # straight fraction at each end of a spring
+# The primitive kernels' loop on the CPU: a band of rows per thread, each band's work in the first of BAND_SLOTS
+# iterations, since Taichi's CPU threads take a parallel loop in blocks of at least 512 (render/physics/runtime.py).
+# A float atomic max is a compare-exchange loop, about 2/3 of the drawing time (rigid_chaos, 720p: rods+bobs
+# 1.1 ms of CPU a frame serial, 2.9 ms on two threads with it), so bands, whose pixels no other thread writes,
+# beat pendulums shared out with atomics.
+BAND_SLOTS = 512
 
 
 @ti.func
@@ -27,6 +33,20 @@ def hue(h):
 
 class Raster:
     """The Canvas's primitives (see above); render/draw/section.py colours its crossings with colour()."""
+
+    @ti.func
+    def slot(self, s):
+        """What iteration s of a primitive kernel's loop draws: pendulums lo <= i < hi, clipped to rows
+        y0 <= y < y1, as (lo, hi, y0, y1). CPU: the first slot of each band draws every pendulum into that
+        band; CUDA: slot s is pendulum s, the whole frame."""
+        out = ti.Vector([s, s + 1, 0, self.h])
+        if ti.static(self.banded):
+            band = s // BAND_SLOTS
+            y0 = band * self.band_rows
+            out = ti.Vector([0, 0, y0, ti.min(self.h, y0 + self.band_rows)])
+            if s % BAND_SLOTS == 0:
+                out[1] = self.n
+        return out
 
     @ti.func
     def colour(self, i):

@@ -116,11 +116,6 @@ def os_error(log: str) -> int | None:
     return min(found)[1] if found else None
 
 
-def yuv_fits(w: int, h: int) -> bool:
-    """Whether render/video/yuv.py converts frames of w×h: rows of RGB in whole 4-byte words, whole 2×2 blocks."""
-    return w % 4 == 0 and h % 2 == 0
-
-
 class _Still:
     """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
 
@@ -176,9 +171,9 @@ class Encoder:
         """planar: convert the MP4's frames to yuv420p before its pipe, in a Taichi kernel (render/video/yuv.py),
         which needs the Taichi a Run started; else ffmpeg converts the rgb24 it is fed."""
         self.yuv = None
-        if planar and yuv_fits(video.width, video.height):
+        if planar:
             from . import yuv  # Taichi: not for a plan (render/config/budget.py reads this module)
-            self.yuv = yuv
+            self.yuv = yuv if yuv.fits(video.width, video.height) else None
         self.targets: list[_Target] = []
         self.written = 0
         self.stills: list[_Still] = []

@@ -28,6 +28,11 @@ def size(w: int, h: int) -> int:
     return w * h * 3 // 2
 
 
+def fits(w: int, h: int) -> bool:
+    """Whether convert() takes frames of w×h: rows of RGB in whole 4-byte words, and whole 2×2 blocks."""
+    return w % 4 == 0 and h % 2 == 0
+
+
 @ti.func
 def _byte(word, k: ti.template()):
     """Byte k of a word as read from memory: x86 is little-endian, so byte 0 is the lowest."""
@@ -85,7 +90,7 @@ def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(d
 
 
 def convert(frame: np.ndarray) -> np.ndarray:
-    """An H×W×3 uint8 RGB frame (render/video/encode.py's yuv_fits()) as a new yuv420p frame: the Y plane, then
+    """An H×W×3 uint8 RGB frame (fits()) as a new yuv420p frame: the Y plane, then
     Cb, then Cr. Taichi must run: a Run starts it (render/physics/stepper.py)."""
     if runtime.generation() == 0:
         raise RuntimeError("yuv.convert: Taichi is not running (a Run starts it)")
