@@ -2,9 +2,10 @@
 
 Its primitives (render/draw/raster.py) are composited with a max per channel, which does not depend on
 drawing order, so frames are byte-identical across runs and thread counts. On the CPU each thread draws every
-primitive into a band of rows of its own, so no pixel has two writers and the max needs no atomic. Each effect has its own kernel, launched (and compiled) only when the scene calls for it. The
-pendulums' view (render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and
-of what the caller draws over the frame (keep_clear).
+primitive into a band of rows of its own, so no pixel has two writers and the max needs no atomic. Each effect
+has its own kernel, launched (and compiled) only when the scene calls for it. The pendulums' view
+(render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and of what the caller
+draws over the frame (keep_clear).
 
 Speed (see benchmarks/README.md): a 720p frame is 0.9 M pixels, but a few hundred pendulums touch only a
 small part of it. Compositing works on TILE×TILE tiles that remember whether this frame's rods and bobs or a
