@@ -67,11 +67,10 @@ class Glow:
         self.decay = int(round(decay * (1 << DECAY_BITS)))
 
     @ti.func
-    def deposit(self, buf: ti.template(), y, x, c, plain: ti.template()):
-        """Add light c (f32, in units of 1) at a pixel, rounded to fixed point first; `plain`: no other thread
-        writes the pixel (a band of rows of its own)."""
+    def deposit(self, cv: ti.template(), buf: ti.template(), y, x, c):
+        """Add light c (f32, in units of 1) at a pixel of canvas cv's layer, rounded to fixed point first."""
         for k in ti.static(range(3)):
-            add(buf[y, x][k], ti.cast(c[k] * FIX + 0.5, ti.i32), plain)
+            add(buf[y, x][k], ti.cast(c[k] * FIX + 0.5, ti.i32), cv.banded)
 
     @ti.func
     def segment(self, cv: ti.template(), buf: ti.template(), tiles: ti.template(), a, b, c, flat: ti.template(),

@@ -6,10 +6,11 @@ Apart from render/draw/canvas.py, which owns the layers, the view and the kernel
 becomes pixels is one idea, what a frame draws and how it is composed another. Raster is a mixin of Taichi
 functions the Canvas inherits; they read only its size (w, h, n, TILE), palette and compositing (rainbow,
 glowing, gain, glow), bands of rows (banded, band_rows), coil amplitude (amp) and layer of bobs (rgb, drawn).
-Coverage comes from the distance to each segment or circle; a primitive is composed with a max per channel, which does not depend on
-drawing order, or under glow is added as light (render/draw/glow.py). Every primitive is clipped to a band of
-rows [y0, y1): on the CPU each thread draws every primitive into its own band (render/draw/canvas.py), so no
-two threads write one pixel and the max needs no atomic; on CUDA the band is the frame and the max is atomic.
+Coverage comes from the distance to each segment or circle; a primitive is composed with a max per channel,
+which does not depend on drawing order, or under glow is added as light (render/draw/glow.py). Every
+primitive is clipped to a band of rows [y0, y1): on the CPU each thread draws every primitive into its own
+band (render/draw/canvas.py), so no two threads write one pixel and the max needs no atomic; on CUDA the band
+is the frame and the max is atomic.
 """
 import taichi as ti
 
@@ -72,7 +73,7 @@ class Raster:
     def plot(self, buf: ti.template(), tiles: ti.template(), y, x, c, y0, y1):
         if 0 <= x < self.w and y0 <= y < y1:
             if ti.static(self.glowing):
-                self.glow.deposit(buf, y, x, c, self.banded)
+                self.glow.deposit(self, buf, y, x, c)
             for k in ti.static(range(3) if not self.glowing else ()):
                 if ti.static(self.banded):
                     buf[y, x][k] = ti.max(buf[y, x][k], c[k])

@@ -220,7 +220,7 @@ class Encoder:
                 except subprocess.TimeoutExpired:
                     pass
                 raise self._failure("stopped", t.error)
-        planar = self.yuv.convert(frame) if any(t.planar for t in self.targets) else None
+        yuv_frame = self.yuv.convert(frame) if any(t.planar for t in self.targets) else None
         for t in self.targets:
             n = 1 if t.repeats is None else t.repeats[self.written]
             if n and t.small is not None:
@@ -228,7 +228,7 @@ class Encoder:
                 if mine.shape != (t.small[1], t.small[0], 3):
                     raise ValueError(f"a GIF frame of {mine.shape[1]}x{mine.shape[0]}, not {t.small[0]}x{t.small[1]}")
             for _ in range(n):
-                t.queue.put(planar if t.planar else frame if t.small is None else mine)
+                t.queue.put(yuv_frame if t.planar else frame if t.small is None else mine)
         self.written += 1
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept
