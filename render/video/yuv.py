@@ -2,14 +2,16 @@
 
 x264 codes yuv420p. Handed rgb24, ffmpeg converted every frame itself (swscale, before x264's threads) and read
 twice the bytes through the pipe. On the 2-core Xeon (AVX-512), rigid_chaos's 1200 frames at 720p from a file
-took ffmpeg 12.2 s of user CPU from rgb24 and 9.9 s from yuv420p, the same x264 settings; the kernel below takes
-0.6 to 0.7 ms a frame on two threads (1.4 s of CPU for the 1200). Whole renders of rigid_chaos took 14.5 and
-15.0 s against 15.7 and 15.9 s before (`pendulum render rigid_chaos`, wall time, alternating).
+took ffmpeg 13.8-14.1 s of user CPU from rgb24 and 11.4-11.7 s from yuv420p, the same x264 settings; the kernel
+below took a median 1.15 ms a frame on two threads, 1.5 s for the 1200 (`python benchmarks/yuv_pipe.py`, two
+rounds). Whole renders of rigid_chaos took 14.5 and 15.0 s against 15.7 and 15.9 s before (`pendulum render
+rigid_chaos`, wall time, alternating).
 
 The conversion is ffmpeg's default one for untagged RGB, BT.601 at limited range (Y 16..235, Cb and Cr
 16..240), in integer fixed point so that every CPU gives the same bytes. Y is swscale's within a level; chroma
 is the mean of each 2×2 block, where swscale filters wider, so at a sharp coloured edge a chroma sample differs
-by up to 18 levels. The decoded MP4 is as close to the frames as before (27.84 dB against 27.86, rigid_chaos).
+by up to 18 levels. The decoded MP4 is as close to the frames as before (27.42 dB against 27.39 from rgb24,
+rigid_chaos: `python benchmarks/mp4_psnr.py`).
 """
 import numpy as np
 import taichi as ti
