@@ -206,6 +206,13 @@ class Encoder:
             self.abort()
             raise
 
+    @property
+    def queues_frames(self) -> bool:
+        """Whether write() queues the frame itself for a pipe (an rgb24 MP4): then it must not change after
+        write(). Fed yuv420p and the GIF's own frames, the Encoder reads the frame only within write(), and a
+        still keeps whatever the frame holds at close()."""
+        return any(not t.planar and t.small is None for t in self.targets)
+
     def write(self, frame: np.ndarray, small: np.ndarray | None = None):
         """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind. `small` is the
         GIF's frame for it, drawn at the GIF's size (render/video/gif.py), where the GIF keeps this frame;
@@ -244,18 +251,18 @@ class Encoder:
                 t.proc.stdin.close()  # EOF: ffmpeg flushes (the GIF's palette needs every frame first)
             except OSError:
                 pass
-        codes = [t.proc.wait() for t in self.targets]
-        errors = [t.error for t in self.targets if t.error is not None]
-        if errors or any(codes):
-            failure = self._failure("failed", errors[0] if errors else f"exit status {max(codes)}")
-            self.abort()
-            raise failure
+        # The MP4's ffmpeg ends long before the GIF's, whose palette needs every frame first (rigid_chaos: 0.16 s
+        # after EOF against 2.0 s): its track is muxed meanwhile, on the core the GIF's one-threaded palettegen
+        # leaves idle, not after it.
         try:
-            for s in self.stills:
-                s.finish()
-            for t in self.targets:
+            for t in sorted(self.targets, key=lambda t: t.final.suffix != ".mp4"):
+                code = t.proc.wait()
+                if t.error is not None or code:
+                    raise self._failure("failed", t.error or f"exit status {code}")  # before abort() kills the rest
                 if audio is not None and t.final.suffix == ".mp4":
                     self._mux(t, *audio)
+            for s in self.stills:
+                s.finish()
         except BaseException:
             self.abort()
             raise
