@@ -86,3 +86,18 @@ def test_mp4_decodes_back(tmp_path, w, planar):
     for f, b in zip(frames, back):
         mse = ((b.astype(float) - f) ** 2).mean()
         assert 10 * np.log10(255 ** 2 / mse) > 24
+
+
+@pytest.mark.parametrize("w", [320, 322])  # 322: not yuv.fits(), so the MP4's pipe is fed the frames themselves
+def test_a_render_drawing_over_one_frame_encodes_what_new_frames_would(tmp_path, w):
+    """pipeline.render draws every frame into one array where the Encoder does not queue it (yuv420p is
+    converted within write()); a frame_hook turns that off. Both give the same MP4, byte for byte."""
+    from render.config.scene import load
+    from render.video import pipeline
+    scene = load("classic", [f"video.width={w}", "video.height=180", "video.fps=30", "video.duration=2",
+                             'video.formats=["mp4"]'])
+    mp4 = []
+    for hook, out in ((None, tmp_path / "one"), (lambda f, frame: None, tmp_path / "new")):
+        pipeline.render(scene, out, frame_hook=hook)
+        mp4.append((scene.out_dir(out) / "classic.mp4").read_bytes())
+    assert mp4[0] == mp4[1]
