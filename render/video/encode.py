@@ -55,6 +55,7 @@ F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call
 #   GIF to its MP4 (tests/test_gif.py's measure) is 0.72 with 48 colours for the whole GIF, 0.28 with 256 for
 #   the whole GIF (9.3 MB) or 96 per frame (8.5 MB), 0.14 with 256 per frame; but that GIF is 11.1 MB, not 5.8.
 MP4_PRESET, MP4_CRF, ROI_QOFFSET = "veryfast", "32", -0.3
+X264_ONE_THREAD_CPUS = 2  # see x264_threads()
 GIF_COLOURS, RAINBOW_COLOURS = 48, 256
 # The GIF's palette is chosen from its frames' colours cut to PALETTE_BITS bits per channel (the centre of each
 # step), and its frames are mapped to it at full depth. palettegen's median cut sorts every distinct colour of
@@ -78,9 +79,25 @@ def roi(video) -> list[str]:
     return ["-vf", f"addroi=0:0:iw*{x}:ih:{q},addroi=iw*(1-{x}):0:iw*{x}:ih:{q}"]
 
 
+def x264_threads() -> list[str]:
+    """x264 on one thread where this process has at most X264_ONE_THREAD_CPUS CPUs. Its own threads (frame
+    threads and a lookahead, 3 or more) cost a fifth more CPU: rigid_chaos's 1200 yuv420p frames took 15.8 s
+    user + 1.2-1.7 s system at its default, 17.0-17.3 s at threads=2, 13.2 s + 0.9 s at one (ffmpeg from a
+    file, 2-core Xeon with AVX-512, 2026-12-06). In a render the other core simulates and draws, so what counts
+    on two cores is the CPU time, not x264's own wall time: one thread took the whole render from 24.2-24.8 s to
+    22.5-22.8 s (alternating, two each). Where x264 is the render's slowest part, a fan light to draw, its own
+    threads would be quicker: one thread pays off while the rest of the render costs at least about 4/5 of
+    x264's CPU time."""
+    return ["-threads", "1"] if _cpus() <= X264_ONE_THREAD_CPUS else []
+
+
+def _cpus() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
 def mp4_args(video) -> list[str]:
-    return [*roi(video), "-c:v", "libx264", "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p",
-            "-movflags", "+faststart", "-f", "mp4"]
+    return [*roi(video), "-c:v", "libx264", *x264_threads(), "-preset", MP4_PRESET, "-crf", MP4_CRF,
+            "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"]
 
 
 def palette_cut(bits: int | None = None) -> tuple[int, int]:
