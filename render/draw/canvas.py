@@ -59,6 +59,7 @@ class Canvas(Raster, runtime.Launcher):
         self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
         self.serial = self.banded and cfg.cpu_max_num_threads <= 4  # bob_pixels: few points, one thread is cheaper
+        self.few = runtime.serial(self.n)  # a loop of a copy per pendulum runs serially (runtime.SERIAL_WORK)
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
         self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, TILE)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
@@ -209,6 +210,7 @@ class Canvas(Raster, runtime.Launcher):
                             b = self.path[k, i]
                     self.segment(self.trail, self.lit, a, b, self.lw, c, w[2], w[3], True)
                     a = b
+        ti.loop_config(serialize=self.few)  # a copy per pendulum: less than waking the threads
         for i in range(self.n):  # after every band has read where the bob was
             self.last[i] = self.pos[i, self.tip]
 

@@ -31,6 +31,20 @@ launched: list[str] = []  # kernel names in first-launch order, since the last i
 # groups, and the idle iterations cost a compare each. Which thread steps a group never changes its bits.
 SPREAD = 128
 
+# A parallel loop wakes Taichi's thread pool and waits for it, whatever its work: a kernel of one loop of 100
+# trivial iterations took 116-127 us a launch on the thread pool, at 1 or 2 threads, and 17-20 us serial (2-core
+# Xeon under KVM, 2026-12-06). So a loop of little work runs serially (ti.loop_config(serialize=...)), its work
+# counted in RK4 pendulum-steps. `python benchmarks/serial_loops.py` there, µs per launch serial / parallel: the
+# rigid advance of 100 pendulums by 17 steps (rigid_chaos's frame) 114 / 324, 1000 pendulums 495 / 641, 4000
+# 1514 / 1361; the energies (about two steps' work each) of 4000 pendulums 223 / 358, of 16000 905 / 758.
+SERIAL_WORK = 8192
+
+
+def serial(work: int) -> bool:
+    """Whether a loop of `work` RK4 pendulum-steps runs on the launching thread (SERIAL_WORK): on the CPU only,
+    where that thread is a core like the pool's (on CUDA it would be one GPU thread)."""
+    return work < SERIAL_WORK and _current is not None and _current[1] == "cpu"
+
 
 def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, keep_log: bool = False) -> str:
     """(Re)initialise Taichi if the settings differ; returns the arch actually in use. The log of kernels and

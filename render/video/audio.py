@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .encode import AUDIO_CODEC, AUDIO_KBPS, AUDIO_RATE
+from ..physics import registry
 
 VOICES = 64  # pendulums heard: a dense cluster once apart; synthesis costs grow with these, not with the fan
 LOW_HZ, OCTAVES = 220.0, 2.0  # a hanging link sings A3, an upright one A5
@@ -30,29 +31,33 @@ def heard(scene) -> bool:
 
 
 def peak_bytes(scene) -> int:
-    """What making the track holds at most (render/config/budget.py counts it): the heard angles of every frame, kept
-    and turned into pitches and phases (about 6 float64 copies), the work arrays of a chunk, and 16 bytes a
-    stereo sample (float32 samples, a channel's squares, then int16). tracemalloc: 32 MB for rigid_chaos."""
+    """What making the track holds at most (render/config/budget.py counts it): the heard pendulums' coordinates
+    at every frame (float64), their first two angles turned into pitches and phases (about 5 float64 copies
+    more), the work arrays of a chunk, and 16 bytes a stereo sample (float32 samples, a channel's squares, then
+    int16). tracemalloc: 32 MB for rigid_chaos."""
     voices = min(VOICES, scene.pendulums.count)
     samples = scene.frames * -(-AUDIO_RATE // scene.video.fps)
-    return scene.frames * voices * 2 * 8 * 6 + 2 * voices * 2 * CHUNK * 4 + 16 * samples
+    record = scene.frames * voices * 8 * (registry.get(scene.system).D + 2 * 5)
+    return record + 2 * voices * 2 * CHUNK * 4 + 16 * samples
 
 
 class Voices:
     """The heard pendulums' first two angles, recorded frame by frame as a render steps; then the track."""
 
-    def __init__(self, sim, fps: int):
+    def __init__(self, sim, fps: int, frames: int):
         self.sim, self.fps = sim, fps
         self.picks = np.unique(np.linspace(0, sim.n - 1, min(VOICES, sim.n)).round().astype(np.int64))
-        self.angles: list[np.ndarray] = []
+        self.q = np.empty((frames, len(self.picks), sim.D))  # the heard pendulums' coordinates, frame by frame
+        self.recorded = 0
 
     def record(self):
         """Call once per frame, with the simulation at that frame's time (frame 0 is t = 0)."""
-        self.angles.append(self.sim.q.to_numpy()[self.picks, :2].astype(np.float64))
+        self.sim.rows_into(self.q, self.recorded, self.picks)
+        self.recorded += 1
 
     def track(self) -> tuple[int, np.ndarray]:
         """(rate, int16 samples of shape (S, 2)): what Encoder.close muxes."""
-        return synthesise(np.asarray(self.angles), self.fps)
+        return synthesise(self.q[:self.recorded, :, :2], self.fps)
 
     def summary(self) -> dict:
         """What metadata.json says of the track."""

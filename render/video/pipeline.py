@@ -174,7 +174,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
     timings["encode"] = 0.0
     voices = None
     if audio.heard(scene):  # the `audio` effect: the fan's angles at every frame make the MP4's track
-        voices = audio.Voices(src.sim, scene.video.fps)
+        voices = audio.Voices(src.sim, scene.video.fps, scene.frames)
     with output_dir(scene.out_dir(out_root)) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video, scene.frames, planar=True)
         small = Frames(src, scene.video, timings) if "gif" in scene.video.formats else None  # the GIF's own
