@@ -1,14 +1,16 @@
-"""The canvas's rod, coil and bob kernels timed alone, at a given thread count: where a frame's drawing goes.
+"""Each kernel of a preset's frames timed alone, at a given thread count: where a frame's simulating and drawing go.
 
     .venv/bin/python benchmarks/draw_kernels.py PRESET [--threads T] [--seconds S] [--set KEY=VALUE]...
 
-Simulates and draws the preset's first S seconds (default 10) as a render does, then, after each frame of the
-second half, launches each primitive kernel once more on its own (synchronised) and prints the median ms of
-each. Relaunching draws the same pixels again, which a max leaves as they were.
+Simulates and draws the preset's first S seconds (default 10) as a render does (nothing encoded), once to
+compile, then again with every kernel launch synchronised and timed (wall and this process's CPU time, both
+threads together), and prints each kernel's ms per frame over the whole run, and the frame's total without
+the synchronisation. The canvas draws and composes a frame in one kernel (render/draw/canvas.py's draw_frame),
+so its primitives are not timed apart.
 """
 import argparse
+import collections
 import os
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -20,6 +22,7 @@ import taichi as ti  # noqa: E402
 
 from render.config.scene import load  # noqa: E402
 from render.draw.canvas import Canvas  # noqa: E402
+from render.physics import runtime  # noqa: E402
 from render.physics.stepper import Run  # noqa: E402
 
 
@@ -33,21 +36,38 @@ def main(argv=None) -> int:
     scene = load(args.preset, [f"video.duration={args.seconds}", *args.overrides])
     run = Run(scene, "cpu", args.threads)
     canvas = Canvas(scene, run.sim)
-    # not the trails: relaunched, stamp_trails would draw a dot where the bob is, not the frame's stretch of path
-    kernels = [k for k, on in (("draw_rods", canvas.rods), ("draw_spring_coils", canvas.springs),
-                               ("draw_bobs", canvas.bobs_on)) if on]
-    frame, ms = canvas.new_frame(), {k: [] for k in kernels}
-    for f in run.frames():
-        canvas.draw(frame)
-        if f >= scene.frames // 2:
-            for name in kernels:
-                ti.sync()
-                t = time.perf_counter()
-                canvas.launch(name)
-                ti.sync()
-                ms[name].append(1e3 * (time.perf_counter() - t))
-    print(f"{scene.name}, {canvas.w}x{canvas.h}, {canvas.bands} band(s), frames {scene.frames // 2}.."
-          f"{scene.frames - 1}: " + ", ".join(f"{k} {statistics.median(v):.3f} ms" for k, v in ms.items()))
+    frame = canvas.new_frame()
+
+    def frames():
+        run.sim.restart()
+        canvas.restart()
+        t, c = time.perf_counter(), time.process_time()
+        for _ in run.frames():
+            canvas.draw(frame)
+        return time.perf_counter() - t, time.process_time() - c
+
+    frames()  # compiles
+    wall, cpu = frames()
+    spent = collections.defaultdict(lambda: [0.0, 0.0])
+    launch = runtime.Launcher.launch
+
+    def timed(self, name, *a):
+        ti.sync()
+        t, c = time.perf_counter(), time.process_time()
+        result = launch(self, name, *a)
+        ti.sync()
+        spent[name][0] += time.perf_counter() - t
+        spent[name][1] += time.process_time() - c
+        return result
+
+    runtime.Launcher.launch = timed
+    frames()
+    runtime.Launcher.launch = launch
+    n = scene.frames
+    print(f"{scene.name}, {canvas.w}x{canvas.h}, {canvas.bands} band(s), {n} frames; ms per frame, wall / CPU:")
+    for name, (w, c) in sorted(spent.items(), key=lambda kv: -kv[1][0]):
+        print(f"  {name:28s} {1e3 * w / n:7.3f} / {1e3 * c / n:7.3f}")
+    print(f"  {'whole frame, unsynchronised':28s} {1e3 * wall / n:7.3f} / {1e3 * cpu / n:7.3f}")
     return 0
 
 

@@ -18,16 +18,10 @@ import taichi as ti
 
 from ..physics import runtime
 from . import framing
-from .raster import BAND_SLOTS, COILS, Raster
+from .raster import BAND_SLOTS, COILS, Raster, to_byte
 
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
-
-
-@ti.func
-def to_byte(c):
-    """One channel of the accumulated colour (f32) to a byte; monotone, so it commutes with the max."""
-    return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
 
 
 @ti.data_oriented
@@ -60,8 +54,11 @@ class Canvas(Raster, runtime.Launcher):
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
         self.serial = self.banded and cfg.cpu_max_num_threads <= 4  # bob_pixels: few points, one thread is cheaper
         self.few = runtime.serial(self.n)  # a loop of a copy per pendulum runs serially (runtime.SERIAL_WORK)
-        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`
-        self.rgb = runtime.field("canvas.frame", light, (self.h, self.w), 3, TILE)
+        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`. Under a max they are kept as
+        # the bytes they print as (the byte of a max is the max of the bytes: raster.to_byte), a quarter of the
+        # memory the frame pass and the primitives read and write; but CUDA's atomic max takes 32-bit values.
+        self.rgb = runtime.field("canvas.frame", ti.u8 if self.banded and not self.glowing else light,
+                                 (self.h, self.w), 3, TILE)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
         self.section, area = None, self.w  # the pendulums' width of the frame: all of it, or left of the section
         if scene.has("poincare"):
@@ -91,6 +88,9 @@ class Canvas(Raster, runtime.Launcher):
         self.amp = 0.035 * self.scale * min(sim.lengths)  # coil amplitude
         self.links = sim.LINKS  # the drawing contract: what joins each pair of points of the chain
         self.tip = len(self.links) - 1
+        # draw_frame is compiled with the primitives the scene calls for: the kernel log says which
+        self.frame_kernel = "draw_frame[" + ",".join(
+            e for e, on in (("rods", self.rods), ("springs", self.springs), ("bobs", self.bobs_on)) if on) + "]"
         self.pos = runtime.field("canvas.bobs_px", ti.f32, (self.n, len(self.links)), 2)
         if self.trails:
             self.trail = runtime.field("canvas.trail", light, (self.h, self.w), 3, TILE)
@@ -108,6 +108,9 @@ class Canvas(Raster, runtime.Launcher):
         if self.trails and gap:
             self.path = runtime.field("canvas.trail_path_px", ti.f32, (gap, self.n), 2)
             self.follows = True
+
+    def kernel(self, name: str):
+        return self.draw_frame if name == self.frame_kernel else super().kernel(name)
 
     @property
     def tracing(self) -> bool:
@@ -148,13 +151,7 @@ class Canvas(Raster, runtime.Launcher):
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0), self.skipped)
             self.skipped = 0
-        if self.rods:
-            self.launch("draw_rods")
-        if self.springs:
-            self.launch("draw_spring_coils")
-        if self.bobs_on:
-            self.launch("draw_bobs")
-        self.launch("compose_frame", out)
+        self.launch(self.frame_kernel, out)
         if self.section is not None:
             self.section.draw(out, self.frame_no == 0)
         if self.hud is not None:
@@ -215,57 +212,68 @@ class Canvas(Raster, runtime.Launcher):
             self.last[i] = self.pos[i, self.tip]
 
     @ti.kernel
-    def draw_rods(self):
+    def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
+        """This frame's rods, coils and bobs, as the scene calls for them, composed with the trails into `out`
+        (zeroed). On the CPU it is one parallel loop: each band's thread draws every primitive into its rows,
+        then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms each in
+        rigid_chaos's frame (runtime.SERIAL_WORK), which was paid by a kernel per primitive and one to compose.
+        On CUDA: a loop over the pendulums (atomic max or adds), then one over the tiles."""
         for s in range(self.slots):
             w = self.slot(s)
             for i in range(w[0], w[1]):
-                for j in ti.static(range(len(self.links))):
-                    if ti.static(self.links[j] == "rod"):
-                        self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
-                                     self.ink(i, 0.55, 0.15), w[2], w[3])
+                self.primitives(i, w[2], w[3])
+            if ti.static(self.banded):
+                if s % BAND_SLOTS == 0:  # the band's own slot: its rows are all drawn now
+                    self.pivot(w[2], w[3])
+                    for ty in range(w[2] // TILE, ti.min(-(-w[3] // TILE), self.ty)):
+                        for tx in range(self.tx):
+                            self.compose(out, ty, tx)
+        if ti.static(not self.banded):
+            self.pivot(0, self.h)
+            for ty, tx in ti.ndrange(self.ty, self.tx):
+                self.compose(out, ty, tx)
 
-    @ti.kernel
-    def draw_spring_coils(self):
-        for s in range(self.slots):
-            w = self.slot(s)
-            for i in range(w[0], w[1]):
+    @ti.func
+    def primitives(self, i, y0, y1):
+        """Pendulum i's rods, coils and bobs in rows y0 <= y < y1, those the scene calls for."""
+        for j in ti.static(range(len(self.links))):
+            if ti.static(self.rods and self.links[j] == "rod"):
+                self.segment(self.rgb, self.drawn, self.joint(i, j), self.pos[i, j], self.lw,
+                             self.ink(i, 0.55, 0.15), y0, y1)
+            if ti.static(self.springs and self.links[j] == "spring"):
+                a, b = self.joint(i, j), self.pos[i, j]
                 for k in range(COILS + 2):
-                    for j in ti.static(range(len(self.links))):
-                        if ti.static(self.links[j] == "spring"):
-                            a, b = self.joint(i, j), self.pos[i, j]
-                            self.segment(self.rgb, self.drawn, self.coil_node(a, b, k),
-                                         self.coil_node(a, b, k + 1), self.lw, self.ink(i, 0.55, 0.15), w[2], w[3])
+                    self.segment(self.rgb, self.drawn, self.coil_node(a, b, k), self.coil_node(a, b, k + 1),
+                                 self.lw, self.ink(i, 0.55, 0.15), y0, y1)
+        if ti.static(self.bobs_on):
+            for j in ti.static(range(len(self.links))):
+                self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0), y0, y1)
 
-    @ti.kernel
-    def draw_bobs(self):
-        for s in range(self.slots):
-            w = self.slot(s)
-            for i in range(w[0], w[1]):
-                for j in ti.static(range(len(self.links))):
-                    self.disc(self.pos[i, j], self.radii[j], self.ink(i, 1.0, 0.0), w[2], w[3])
-        self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]), 0, self.h)
+    @ti.func
+    def pivot(self, y0, y1):
+        if ti.static(self.bobs_on):
+            self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]), y0, y1)
 
-    @ti.kernel
-    def compose_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
-        """max(layer, trail) to bytes in the tiles something touched; `out` arrives zeroed.
+    @ti.func
+    def compose(self, out: ti.template(), ty, tx):
+        """max(layer, trail) to bytes in a tile something touched; `out` arrives zeroed.
 
         It clears the layer and fades the trail as it reads them. Fading after reading equals the old
         fade-before-stamp order bit for bit. A faded trail value that would print as 0 is set to exactly 0:
         it could never show again (the byte of a max is the max of the bytes), and the tile can go dark.
         """
-        for ty, tx in ti.ndrange(self.ty, self.tx):
-            drawn = self.drawn[ty, tx]
-            if ti.static(self.trails):
-                lit = self.lit[ty, tx]
-                if drawn and lit:  # one branch per tile, so each pixel loop is straight-line code
-                    self.lit[ty, tx] = self.tile(out, ty, tx, True, True)
-                elif lit:
-                    self.lit[ty, tx] = self.tile(out, ty, tx, False, True)
-                elif drawn:
-                    self.tile(out, ty, tx, True, False)
+        drawn = self.drawn[ty, tx]
+        if ti.static(self.trails):
+            lit = self.lit[ty, tx]
+            if drawn and lit:  # one branch per tile, so each pixel loop is straight-line code
+                self.lit[ty, tx] = self.tile(out, ty, tx, True, True)
+            elif lit:
+                self.lit[ty, tx] = self.tile(out, ty, tx, False, True)
             elif drawn:
                 self.tile(out, ty, tx, True, False)
-            self.drawn[ty, tx] = 0
+        elif drawn:
+            self.tile(out, ty, tx, True, False)
+        self.drawn[ty, tx] = 0
 
     @ti.func
     def tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
@@ -278,25 +286,31 @@ class Canvas(Raster, runtime.Launcher):
 
     @ti.func
     def compose_tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
-        """One tile; returns whether any trail in it is still visible after fading."""
+        """One tile; returns whether any trail in it is still visible after fading. The max of the layer's and
+        the trail's bytes, which is the byte of their max (raster.to_byte)."""
         lit = 0
         for y in range(ty * TILE, ti.min(ty * TILE + TILE, self.h)):
             for x in range(tx * TILE, ti.min(tx * TILE + TILE, self.w)):
-                c = ti.Vector([0.0, 0.0, 0.0], ti.f32)
+                b = ti.Vector([0, 0, 0], ti.i32)
                 if ti.static(layer):
                     c = self.rgb[y, x]
-                    self.rgb[y, x] = ti.Vector([0.0, 0.0, 0.0], ti.f32)
+                    self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
+                    for k in ti.static(range(3)):
+                        if ti.static(self.rgb.dtype == ti.u8):
+                            b[k] = ti.cast(c[k], ti.i32)
+                        else:
+                            b[k] = ti.cast(to_byte(c[k]), ti.i32)
                 if ti.static(trail):
                     t = self.trail[y, x]
                     if t.max() > 0.0:  # most pixels of a lit tile are off the trail: nothing to fade
-                        c = ti.max(c, t)
                         faded = ti.cast(t * self.decay, ti.f32)
                         for k in ti.static(range(3)):
+                            b[k] = ti.max(b[k], ti.cast(to_byte(t[k]), ti.i32))
                             if to_byte(faded[k]) == 0:
                                 faded[k] = 0.0
                             else:
                                 lit = 1
                         self.trail[y, x] = faded
                 for k in ti.static(range(3)):
-                    out[y, x, k] = to_byte(c[k])
+                    out[y, x, k] = ti.cast(b[k], ti.u8)
         return lit

@@ -25,6 +25,12 @@ BAND_SLOTS = 512
 
 
 @ti.func
+def to_byte(c):
+    """One channel of a colour (f32) to a byte; monotone, so it commutes with the max."""
+    return ti.cast(ti.min(c, 1.0) * 255.0 + 0.5, ti.u8)
+
+
+@ti.func
 def hue(h):
     """HSV (h, 1, 1) to RGB, h in [0, 1)."""
     k = ti.Vector([5.0, 3.0, 1.0])
@@ -75,10 +81,13 @@ class Raster:
             if ti.static(self.glowing):
                 self.glow.deposit(self, buf, y, x, c)
             for k in ti.static(range(3) if not self.glowing else ()):
-                if ti.static(self.banded):
-                    buf[y, x][k] = ti.max(buf[y, x][k], c[k])
-                else:
+                if ti.static(not self.banded):
                     ti.atomic_max(buf[y, x][k], c[k])
+                elif ti.static(buf.dtype == ti.u8):  # a layer of bytes: the byte of the max
+                    old = ti.cast(buf[y, x][k], ti.i32)
+                    buf[y, x][k] = ti.cast(ti.max(old, ti.cast(to_byte(c[k]), ti.i32)), ti.u8)
+                else:
+                    buf[y, x][k] = ti.max(buf[y, x][k], c[k])
             tiles[y // self.TILE, x // self.TILE] = 1  # every writer stores the same 1: the race is harmless
 
     @ti.func
