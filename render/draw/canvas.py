@@ -2,31 +2,27 @@
 
 Its primitives (render/draw/raster.py) are composited with a max per channel, which does not depend on
 drawing order, so frames are byte-identical across runs and thread counts. On the CPU each thread draws every
-primitive into a band of rows of its own, so no pixel has two writers and the max needs no atomic. Each effect
-has its own kernel, launched (and compiled) only when the scene calls for it. The pendulums' view
-(render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and of what the caller
-draws over the frame (keep_clear).
-
-Speed (see benchmarks/README.md): a 720p frame is 0.9 M pixels, but a few hundred pendulums touch only a
-small part of it. Compositing works on TILE×TILE tiles that remember whether this frame's rods and bobs or a
-still-visible trail touched them; the others stay as the zeroed frame left them, and no buffer is read for
-them. The frame pass also clears the layer it reads and fades the trail in place, and it writes the output
-array itself (a kernel argument), so there is no separate clear, fade or field-to-numpy copy.
+primitive into a band of rows of its own, so no pixel has two writers and the max needs no atomic, then
+composes its rows (render/draw/compose.py). A frame is three kernels: the bobs' pixels, the trails' stamp
+(with trails) and draw_frame, compiled with the primitives the scene calls for and no others. The pendulums'
+view (render/draw/framing.py) holds everything they can ever reach, clear of the HUD's boxes and of what the
+caller draws over the frame (keep_clear).
 """
 import numpy as np
 import taichi as ti
 
 from ..physics import runtime
 from . import framing
-from .raster import BAND_SLOTS, COILS, Raster, to_byte
+from .compose import Compose
+from .raster import BAND_SLOTS, COILS, Raster
 
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
 
 
 @ti.data_oriented
-class Canvas(Raster, runtime.Launcher):
-    TILE = TILE  # for its primitives (render/draw/raster.py) and render/draw/glow.py, which mark and compose its tiles
+class Canvas(Raster, Compose, runtime.Launcher):
+    TILE = TILE  # for its primitives (render/draw/raster.py), its frame pass (compose.py) and glow.py
 
     def __init__(self, scene, sim, info=None, keep_clear=()):
         """info: what the `hud` effect says beyond the drawing contract (render/draw/hud.py's Info; from the scene
@@ -97,6 +93,7 @@ class Canvas(Raster, runtime.Launcher):
             self.lit = runtime.field("canvas.trail_tiles", ti.i32, (self.ty, self.tx))  # tiles with a visible trail
             self.last = runtime.field("canvas.trail_last_px", ti.f32, self.n, 2)
         self.path, self.follows, self.skipped = None, False, 0  # see follow()
+        self.keep_frames()  # the frame drawn last is drawn over without a clear (compose.py)
         self.fps = v.fps
         self.frame_no = 0
 
@@ -127,7 +124,7 @@ class Canvas(Raster, runtime.Launcher):
 
     def restart(self):
         """Back to the first frame: no trail yet."""
-        self.frame_no = 0
+        self.frame_no, self.kept = 0, None
         if self.section is not None:
             self.section.restart()
         if self.trails:
@@ -136,17 +133,14 @@ class Canvas(Raster, runtime.Launcher):
         self.skipped = 0
 
     def new_frame(self) -> np.ndarray:
-        """A frame for draw(): zeroed, since compose_frame writes only tiles something touched."""
+        """A frame for draw(), which it fills whole."""
         return np.zeros((self.h, self.w, 3), np.uint8)
 
     def draw(self, out: np.ndarray | None = None, t: float | None = None) -> np.ndarray:
         """The current state of the simulation as an H×W×3 uint8 frame, written into `out` if given.
 
         t is the simulated time, for the HUD's clock (default: one frame per draw since the start)."""
-        if out is None:
-            out = self.new_frame()
-        else:
-            out.fill(0)  # compose_frame writes only the tiles something touched (a memset is far cheaper)
+        out = self.frame_for(out)
         self.launch("bob_pixels")
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0), self.skipped)
@@ -159,7 +153,7 @@ class Canvas(Raster, runtime.Launcher):
         self.frame_no += 1
         return out
 
-    # ------------------------------------------------------------ kernels, one per effect
+    # ------------------------------------------------------------ kernels
     @ti.func
     def joint(self, i, j: ti.template()):
         """Where link j of pendulum i starts: the pivot, or the previous bob."""
@@ -192,7 +186,7 @@ class Canvas(Raster, runtime.Launcher):
 
     @ti.kernel
     def stamp_trails(self, first: ti.i32, skipped: ti.i32):
-        """The outer bob's path since the last frame into the trail layer (compose_frame fades it): through
+        """The outer bob's path since the last frame into the trail layer (the frame pass fades it): through
         the points of the `skipped` frames before this one (follow()), then to where it is now."""
         for s in range(self.slots):
             w = self.slot(s)
@@ -214,10 +208,10 @@ class Canvas(Raster, runtime.Launcher):
     @ti.kernel
     def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
         """This frame's rods, coils and bobs, as the scene calls for them, composed with the trails into `out`
-        (zeroed). On the CPU it is one parallel loop: each band's thread draws every primitive into its rows,
-        then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms each in
-        rigid_chaos's frame (runtime.SERIAL_WORK), which was paid by a kernel per primitive and one to compose.
-        On CUDA: a loop over the pendulums (atomic max or adds), then one over the tiles."""
+        (render/draw/compose.py). On the CPU it is one parallel loop: each band's thread draws every primitive
+        into its rows, then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms
+        each in rigid_chaos's frame (2-core Xeon; runtime.SERIAL_WORK), which was paid by a kernel per primitive
+        and one to compose. On CUDA: a loop over the pendulums (atomic max or adds), then one over the tiles."""
         for s in range(self.slots):
             w = self.slot(s)
             for i in range(w[0], w[1]):
@@ -253,64 +247,3 @@ class Canvas(Raster, runtime.Launcher):
     def pivot(self, y0, y1):
         if ti.static(self.bobs_on):
             self.disc(ti.Vector([self.cx, self.cy], ti.f32), 3.0, ti.Vector([0.8, 0.8, 0.8]), y0, y1)
-
-    @ti.func
-    def compose(self, out: ti.template(), ty, tx):
-        """max(layer, trail) to bytes in a tile something touched; `out` arrives zeroed.
-
-        It clears the layer and fades the trail as it reads them. Fading after reading equals the old
-        fade-before-stamp order bit for bit. A faded trail value that would print as 0 is set to exactly 0:
-        it could never show again (the byte of a max is the max of the bytes), and the tile can go dark.
-        """
-        drawn = self.drawn[ty, tx]
-        if ti.static(self.trails):
-            lit = self.lit[ty, tx]
-            if drawn and lit:  # one branch per tile, so each pixel loop is straight-line code
-                self.lit[ty, tx] = self.tile(out, ty, tx, True, True)
-            elif lit:
-                self.lit[ty, tx] = self.tile(out, ty, tx, False, True)
-            elif drawn:
-                self.tile(out, ty, tx, True, False)
-        elif drawn:
-            self.tile(out, ty, tx, True, False)
-        self.drawn[ty, tx] = 0
-
-    @ti.func
-    def tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
-        lit = 0
-        if ti.static(not self.glowing):
-            lit = self.compose_tile(out, ty, tx, layer, trail)
-        else:
-            lit = self.glow.compose_tile(self, out, ty, tx, layer, trail)
-        return lit
-
-    @ti.func
-    def compose_tile(self, out: ti.template(), ty, tx, layer: ti.template(), trail: ti.template()):
-        """One tile; returns whether any trail in it is still visible after fading. The max of the layer's and
-        the trail's bytes, which is the byte of their max (raster.to_byte)."""
-        lit = 0
-        for y in range(ty * TILE, ti.min(ty * TILE + TILE, self.h)):
-            for x in range(tx * TILE, ti.min(tx * TILE + TILE, self.w)):
-                b = ti.Vector([0, 0, 0], ti.i32)
-                if ti.static(layer):
-                    c = self.rgb[y, x]
-                    self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
-                    for k in ti.static(range(3)):
-                        if ti.static(self.rgb.dtype == ti.u8):
-                            b[k] = ti.cast(c[k], ti.i32)
-                        else:
-                            b[k] = ti.cast(to_byte(c[k]), ti.i32)
-                if ti.static(trail):
-                    t = self.trail[y, x]
-                    if t.max() > 0.0:  # most pixels of a lit tile are off the trail: nothing to fade
-                        faded = ti.cast(t * self.decay, ti.f32)
-                        for k in ti.static(range(3)):
-                            b[k] = ti.max(b[k], ti.cast(to_byte(t[k]), ti.i32))
-                            if to_byte(faded[k]) == 0:
-                                faded[k] = 0.0
-                            else:
-                                lit = 1
-                        self.trail[y, x] = faded
-                for k in ti.static(range(3)):
-                    out[y, x, k] = ti.cast(b[k], ti.u8)
-        return lit
