@@ -18,6 +18,13 @@ from .raster import BAND_SLOTS, COILS, Raster
 
 TRAIL_FLOOR = 0.03  # a trail fades to this brightness over video.trail_seconds
 TILE = 8  # pixels per tile side for compositing: small enough to hug thin trails, cheap to track (14k at 720p)
+# A band of rows per thread pays for its wake-up of the thread pool (runtime.SERIAL_WORK) in a heavy frame only:
+# below this many primitives (pendulums x links) times rows, a frame draws on the launching thread. Whole
+# frames, ms wall / CPU, in two bands and in one (`python benchmarks/draw_kernels.py PRESET`, 2-core Xeon,
+# 2026-12-06): rigid_chaos (144k) 5.83 / 6.86 and 4.99 / 4.99; its GIF's 352x198 frame 2.69 / 2.57 and
+# 1.84 / 1.84; triple_chaos (216k) 5.21 / 5.96 and 4.63 / 4.63; rainbow_1000 (1.44M) 8.08 / 9.73 and 10.38 /
+# 10.27. And in a render on two cores the encoders hold the other one.
+BANDED_WORK = 720_000
 
 
 @ti.data_oriented
@@ -45,7 +52,9 @@ class Canvas(Raster, Compose, runtime.Launcher):
         self.ty, self.tx = -(-self.h // TILE), -(-self.w // TILE)
         cfg = ti.lang.impl.current_cfg()
         self.banded = cfg.arch != ti.cuda  # else (CUDA) one pendulum per loop iteration, the max atomic
-        self.bands = max(1, cfg.cpu_max_num_threads) if self.banded else 1
+        heavy = self.n * len(sim.LINKS) * self.h >= BANDED_WORK
+        self.bands = max(1, cfg.cpu_max_num_threads) if self.banded and heavy else 1
+        self.one_band = self.banded and self.bands == 1  # its loops on the launching thread
         self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
         self.serial = self.banded and cfg.cpu_max_num_threads <= 4  # bob_pixels: few points, one thread is cheaper
@@ -188,6 +197,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
     def stamp_trails(self, first: ti.i32, skipped: ti.i32):
         """The outer bob's path since the last frame into the trail layer (the frame pass fades it): through
         the points of the `skipped` frames before this one (follow()), then to where it is now."""
+        ti.loop_config(serialize=self.one_band)
         for s in range(self.slots):
             w = self.slot(s)
             for i in range(w[0], w[1]):
@@ -212,6 +222,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
         into its rows, then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms
         each in rigid_chaos's frame (2-core Xeon; runtime.SERIAL_WORK), which was paid by a kernel per primitive
         and one to compose. On CUDA: a loop over the pendulums (atomic max or adds), then one over the tiles."""
+        ti.loop_config(serialize=self.one_band)
         for s in range(self.slots):
             w = self.slot(s)
             for i in range(w[0], w[1]):

@@ -49,11 +49,17 @@ def _round(v, shift: ti.template()):
 # Taichi's CPU threads take a parallel loop in blocks of at least 512 iterations (render/physics/runtime.py):
 # a loop over 360 rows of groups would run on one thread, so each row is cut into PIECES runs of groups.
 PIECES = 16
+# On two CPUs or fewer the loop runs on the launching thread: the conversion is bound by memory, and the thread
+# pool's wake-up cost CPU time that x264 needs on the other core. rigid_chaos's second 10 s of 720p frames,
+# from memory: 1.79 ms wall and 2.60 ms CPU a frame on two threads, 1.75 ms and 1.75 ms serial (2-core Xeon,
+# 2026-12-06, medians of 3 rounds).
+SERIAL_THREADS = 2
 
 
 @ti.kernel
 def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(dtype=ti.u32, ndim=1),
-             cb2: ti.types.ndarray(dtype=ti.u16, ndim=1), cr2: ti.types.ndarray(dtype=ti.u16, ndim=1), w: ti.i32):
+             cb2: ti.types.ndarray(dtype=ti.u16, ndim=1), cr2: ti.types.ndarray(dtype=ti.u16, ndim=1), w: ti.i32,
+             serial: ti.template()):
     """Groups of 4×2 pixels: in each of its two rows 12 bytes of RGB are 3 words (the frame's rows are whole
     words since its width is a multiple of 4), out come a word of Y per row and two bytes each of Cb and Cr.
     Most of a frame is black, and a black group is 6 loads and 4 stores. The arrays are flat: 2-D ndarray
@@ -61,6 +67,7 @@ def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(d
     gw = w // 4
     rows = cb2.shape[0] // gw  # rows of groups: half the frame's height
     run = (gw + PIECES - 1) // PIECES
+    ti.loop_config(serialize=serial)
     for t in range(rows * PIECES):
         gy, piece = t // PIECES, t % PIECES
         for gx in range(piece * run, ti.min(piece * run + run, gw)):
@@ -100,5 +107,6 @@ def convert(frame: np.ndarray) -> np.ndarray:
     out = np.empty(size(w, h), np.uint8)
     n, c = w * h, w * h // 4
     words = np.ascontiguousarray(frame).reshape(-1).view(np.uint32)
-    _convert(words, out[:n].view(np.uint32), out[n:n + c].view(np.uint16), out[n + c:].view(np.uint16), w)
+    serial = ti.lang.impl.current_cfg().cpu_max_num_threads <= SERIAL_THREADS
+    _convert(words, out[:n].view(np.uint32), out[n:n + c].view(np.uint16), out[n + c:].view(np.uint16), w, serial)
     return out
