@@ -124,20 +124,6 @@ def test_fractal_frames_do_not_depend_on_thread_count(tmp_path):
     assert runs[0] == runs[1]
 
 
-@pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000"])  # max compositing, and glow's light
-def test_drawing_in_bands_gives_the_same_bytes_at_any_thread_count(tmp_path, name):
-    """On the CPU each thread draws every primitive into a band of rows of its own (render/draw/canvas.py):
-    one band at 1 thread, bands of uneven height at 3, thin ones at 8, and the same frames from each."""
-    scene = load(name, ["video.width=320", "video.height=180", "video.duration=1", 'video.formats=["mp4"]'])
-    runs = []
-    for threads in (1, 3, 8):
-        frames = []
-        pipeline.render(scene, tmp_path / str(threads), threads=threads,
-                        frame_hook=lambda f, fr: frames.append(fr.tobytes()))
-        runs.append(frames)
-    assert len(runs[0]) == scene.frames and runs[0] == runs[1] == runs[2]
-
-
 def test_interleaved_rounds_take_each_side_in_turn():
     calls = []
 

@@ -5,13 +5,51 @@ import numpy as np
 import pytest
 
 from render.config.scene import load
+from render.draw import canvas as canvas_module
 from render.draw.canvas import Canvas
 from render.physics.stepper import Run
+from render.video import pipeline
 
 
-@pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000", "elastic_fan", "poincare_shell"])
-def test_drawing_over_the_last_frame_gives_the_bytes_of_a_new_frame(name):
+def force_bands(monkeypatch) -> list:
+    """Every canvas made from now on draws in a band per thread, however light its frame (BANDED_WORK);
+    returns the list their band counts are appended to."""
+    monkeypatch.setattr(canvas_module, "BANDED_WORK", 0)
+    bands, init = [], Canvas.__init__
+
+    def counted(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        bands.append(self.bands)
+    monkeypatch.setattr(Canvas, "__init__", counted)
+    return bands
+
+
+@pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000"])  # max compositing, and glow's light
+def test_drawing_in_bands_gives_the_same_bytes_at_any_thread_count(tmp_path, name, monkeypatch):
+    """On the CPU each thread can draw every primitive into a band of rows of its own: one band at 1 thread,
+    bands of uneven height at 3, thin ones at 8, and the same frames from each, and from a frame light enough
+    to draw on the launching thread alone, as these small ones are unless bands are forced."""
+    scene = load(name, ["video.width=320", "video.height=180", "video.duration=1", 'video.formats=["mp4"]'])
+    runs = []
+
+    def render(threads, out):
+        frames = []
+        pipeline.render(scene, out, threads=threads, frame_hook=lambda f, fr: frames.append(fr.tobytes()))
+        runs.append(frames)
+    render(8, tmp_path / "light")
+    bands = force_bands(monkeypatch)
+    for threads in (1, 3, 8):
+        render(threads, tmp_path / str(threads))
+    assert len(runs[0]) == scene.frames and runs[0] == runs[1] == runs[2] == runs[3]
+    assert {1, 3, 8} <= set(bands), bands
+
+
+@pytest.mark.parametrize("name, banded", [("rigid_chaos", False), ("rigid_chaos", True), ("rainbow_1000", True),
+                                          ("elastic_fan", False), ("poincare_shell", False)])
+def test_drawing_over_the_last_frame_gives_the_bytes_of_a_new_frame(name, banded, monkeypatch):
     # rigid_chaos: the HUD's clock changes its digits every frame, and its trails fade out tile by tile
+    if banded:
+        force_bands(monkeypatch)
     scene = load(name, ["video.width=320", "video.height=180", "video.fps=30", "video.duration=4"])
     runs = []
     for kept in (False, True):
