@@ -1,4 +1,4 @@
-"""What the GIF's palette cut (render/video/encode.py: PALETTE_BITS) saves and costs, on a preset's own GIF frames.
+"""What the GIF's palette cut (render/video/palette.py: PALETTE_BITS) saves and costs, on a preset's own GIF frames.
 
     .venv/bin/python benchmarks/gif_palette.py [PRESET] [--bits 8 7 6] [--rate 50]
 
@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from render.config.scene import load  # noqa: E402
-from render.video import encode, gif, pipeline  # noqa: E402
+from render.video import encode, gif, palette, pipeline  # noqa: E402
 
 CORNER = (slice(0, 17), slice(0, 90))  # the clock's line at the GIF's size (render/draw/hud_text.py)
 
@@ -41,7 +41,7 @@ def gif_frames(name: str) -> tuple[object, list[np.ndarray]]:
 def tail(scene, frames, bits: int, rate: float, out: Path) -> float:
     """Seconds the render's Encoder spends in close() (the GIF's palette and mapping after the last frame), fed
     `rate` frames per second. Its video is the GIF's own size and rate, so each frame is one GIF frame."""
-    encode.PALETTE_BITS = bits
+    palette.PALETTE_BITS = bits
     h, w = frames[0].shape[:2]
     video = dataclasses.replace(scene.video, width=w, height=h, gif_width=w, fps=gif.rate(scene.video),
                                 formats=("gif",))
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     scene, frames = gif_frames(args.preset)
     raw = np.stack(frames)
-    colours = {b: distinct(raw, *encode.palette_cut(b)) for b in args.bits}
+    colours = {b: distinct(raw, *palette.palette_cut(b)) for b in args.bits}
     waits = {b: [] for b in args.bits}
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(args.rounds):

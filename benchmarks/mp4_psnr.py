@@ -1,5 +1,5 @@
 """How close a rendered MP4 decodes to the frames it was made from: PSNR over the whole frame and over the two
-columns beside the pendulums' circle (the HUD's, which get x264's finer quantiser: render/video/encode.py's roi).
+columns beside the pendulums' circle (the HUD's, which get x264's finer quantiser: render/video/mp4.py's roi).
 
     .venv/bin/python benchmarks/mp4_psnr.py PRESET --mp4 out/PRESET/PRESET.mp4 [--every K] [--set KEY=VALUE]...
 
@@ -18,7 +18,7 @@ import imageio.v3 as iio  # noqa: E402
 import numpy as np  # noqa: E402
 
 from render.config.scene import load  # noqa: E402
-from render.video import encode, pipeline  # noqa: E402
+from render.video import mp4, pipeline  # noqa: E402
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -35,7 +35,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     src = pipeline.Source(load(args.preset, args.overrides))
     v = src.scene.video
-    side = int((v.width - 2 * encode.REACH * v.height) / 2)  # the columns roi() quantises finer
+    side = int((v.width - 2 * mp4.REACH * v.height) / 2)  # the columns roi() quantises finer
     whole, hud = [], []
     for f, decoded in enumerate(iio.imiter(args.mp4, plugin="FFMPEG")):
         frame = src.next_frame()

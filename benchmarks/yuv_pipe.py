@@ -4,7 +4,7 @@
 
 Draws the preset's frames (pipeline.Source, as `pendulum render` draws them) into a raw rgb24 file in DIR
 (default out/yuv_pipe), timing yuv.convert on each; writes the converted frames beside them. Then ffmpeg encodes
-the MP4 from each file with the render's own x264 arguments (encode.mp4_args), rgb24 and yuv420p alternating for
+the MP4 from each file with the render's own x264 arguments (mp4.args), rgb24 and yuv420p alternating for
 --rounds rounds, and prints each encode's wall time and ffmpeg's user CPU. The raw files (3.3 GB and 1.7 GB for
 rigid_chaos) and the MP4s are deleted at the end.
 """
@@ -23,14 +23,14 @@ import imageio_ffmpeg  # noqa: E402
 import numpy as np  # noqa: E402
 
 from render.config.scene import load  # noqa: E402
-from render.video import encode, pipeline, yuv  # noqa: E402
+from render.video import mp4 as mp4_settings, pipeline, yuv  # noqa: E402
 
 
 def encode_file(raw: Path, pix_fmt: str, video, mp4: Path) -> tuple[float, float]:
     """(wall s, ffmpeg's user CPU s) for one MP4 from a raw file."""
     cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo",
            "-pix_fmt", pix_fmt, "-s", f"{video.width}x{video.height}", "-r", str(video.fps), "-i", str(raw),
-           "-an", *encode.mp4_args(video), str(mp4)]
+           "-an", *mp4_settings.args(video), str(mp4)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
     t = time.perf_counter()
     subprocess.run(cmd, check=True)

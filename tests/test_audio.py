@@ -16,7 +16,7 @@ import pytest
 from conftest import run_cli
 from render.video import audio
 from render.config import budget
-from render.video import encode, pipeline
+from render.video import encode, mp4, pipeline
 from render.physics import reference, registry
 from render.errors import EncodeError, SceneError
 from render.config.scene import load
@@ -133,7 +133,7 @@ def test_the_track_leaves_the_video_stream_as_it_was_and_a_failed_mux_leaves_not
     assert list(sizes) == ["x.mp4"] and [p.name for p in (tmp_path / "sound").iterdir()] == ["x.mp4"]
     assert h264(tmp_path / "sound" / "x.mp4") == h264(tmp_path / "plain" / "x.mp4")
     assert len(streams(tmp_path / "plain" / "x.mp4")) == 1 and len(decode(tmp_path / "sound" / "x.mp4")) > 0
-    monkeypatch.setattr(encode, "AUDIO_CODEC", "no_such_codec")
+    monkeypatch.setattr(mp4, "AUDIO_CODEC", "no_such_codec")
     with pytest.raises(EncodeError, match="failed adding the audio"):
         encode_frames(tmp_path / "failed", track)
     assert not any((tmp_path / "failed").iterdir())  # neither the MP4 nor either temporary

@@ -339,12 +339,12 @@ def test_simulate_keeps_every_frame_in_memory():
     assert "pendulums.count, video.duration: needs about" in msg and "of this machine's" in msg
 
 
-def test_ffmpeg_holding_every_gif_frame_counts_as_memory():
+def test_holding_every_gif_frame_for_its_palette_counts_as_memory():
     scene = make_scene(video={"width": 1920, "height": 1080, "gif_width": 1920, "fps": 50, "duration": 3600.0},
                        integrator={"dt": 0.02})
     need, key, detail = budget.memory(scene, registry.get(scene.system), simulate=False)
-    assert key == "video.gif_width, video.duration" and "GIF frames held by ffmpeg" in detail
-    assert need > 1920 * 1080 * 4 * scene.video.gif_fps * 3600  # an hour of GIF frames of 4-byte pixels
+    assert key == "video.gif_width, video.duration" and "GIF frames held for its palette" in detail
+    assert need > 1920 * 1080 * 3 * scene.video.gif_fps * 3600  # an hour of GIF frames of 3-byte pixels
 
 
 def test_output_beyond_the_free_space_is_refused(monkeypatch):

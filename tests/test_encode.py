@@ -1,5 +1,6 @@
-"""render/video/encode.py and gif.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps filter picked
-them, and shrunk before it, exactly as an area average does."""
+"""render/video/encode.py, gif.py and palette.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps
+filter picked them, and shrunk before it, exactly as an area average does; its palette is palettegen's, and its
+pixels are mapped to it as written here."""
 import itertools
 import math
 import subprocess
@@ -9,9 +10,17 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 
-from render.video import encode, gif
+from render.video import encode, gif, palette
 
 EXE = imageio_ffmpeg.get_ffmpeg_exe()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def taichi():
+    """The GIF's frames are mapped to its palette on the Taichi a Run starts, as in a render."""
+    from render.config.scene import load
+    from render.physics.stepper import Run
+    Run(load("classic", ["video.duration=0.1"]), "cpu")
 
 
 def video(fps, gif_fps=20, width=64, height=36, gif_width=32):
@@ -38,9 +47,10 @@ def test_gif_picks_are_the_fps_filters(fps, gif_fps):
         assert mine == fps_filter_picks(fps, min(fps, gif_fps), frames), (fps, gif_fps, frames)
 
 
-def test_the_gif_is_byte_identical_to_the_one_the_fps_filter_made(tmp_path):
-    """Every frame (shrunk to the GIF's size) through ffmpeg's fps filter, and only the picked ones at the GIF's
-    rate, shrunk by the encoder: the same file, bit for bit, while the pipe carries a third of the frames."""
+def test_the_gif_is_byte_identical_to_one_of_the_frames_the_fps_filter_picks(tmp_path):
+    """Every frame at 60 fps (shrunk to the GIF's size by the encoder), and only the ones ffmpeg's fps filter
+    picks, handed over at the GIF's rate: the same file, bit for bit, while the pipe carries a third of the
+    frames."""
     v, n = video(60, 20, 96, 54, 48), 47
     rng = np.random.default_rng(5)
     frames = [rng.integers(0, 255, (54, 96, 3), dtype=np.uint8) for _ in range(n)]
@@ -49,19 +59,27 @@ def test_the_gif_is_byte_identical_to_the_one_the_fps_filter_made(tmp_path):
     for f in frames:
         enc.write(f)
     enc.close()
-    graph = "fps=20:eof_action=pass," + encode.gif_args(v)[1]
-    cmd = [EXE, "-nostdin", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "48x28",
-           "-r", "60", "-i", "-", "-an", "-vf", graph, "-loop", "0", "-f", "gif", str(tmp_path / "filtered.gif")]
-    subprocess.run(cmd, input=b"".join(gif.shrink(f, 48, 28).tobytes() for f in frames), check=True)
+    picks = fps_filter_picks(60, 20, n)
+    enc = encode.Encoder(tmp_path, "filtered", video(20, 20, 48, 28, 48), len(picks), formats=["gif"])
+    for i in picks:
+        enc.write(gif.shrink(frames[i], 48, 28))
+    enc.close()
     assert (tmp_path / "picked.gif").read_bytes() == (tmp_path / "filtered.gif").read_bytes()
-    assert piped == 16 and piped == len(list(itertools.islice(frames, 0, n, 3)))
+    assert piped == len(picks) == 16 == len(list(itertools.islice(frames, 0, n, 3)))
 
 
-def test_the_gif_palette_is_chosen_from_colours_cut_to_palette_bits_and_maps_the_full_frames(tmp_path):
-    """The Encoder's GIF is, bit for bit, the GIF of a palette made (by ffmpeg's own palettegen, with the
-    shipped settings) from every palette_step-th frame cut in numpy to PALETTE_BITS per channel at each step's
-    centre, mapped onto all the uncut frames; and cutting, or counting every frame, changes the palette of
-    these frames, so the test can tell."""
+def decoded(path) -> np.ndarray:
+    out = subprocess.run([EXE, "-v", "error", "-i", str(path), "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                         capture_output=True, check=True).stdout
+    return np.frombuffer(out, np.uint8)
+
+
+def test_the_gif_palette_is_palettegens_of_sampled_cut_frames_and_each_pixel_its_dithered_nearest(tmp_path):
+    """The Encoder's GIF decodes back to: the palette ffmpeg's palettegen makes (run here, with the shipped
+    settings) of every palette_step-th frame cut in numpy to PALETTE_BITS per channel at each step's centre;
+    each pixel the first palette colour nearest, in RGB, to its full colour plus the 8x8 Bayer dither of its
+    place, written here from the matrix's definition. And cutting, or counting every frame, changes the
+    palette of these frames, so the test can tell."""
     v, n = video(20, 20, 48, 28, 48), 12
     rng = np.random.default_rng(11)
     frames = [rng.integers(0, 256, (28, 48, 3), dtype=np.uint8) for _ in range(n)]
@@ -69,27 +87,32 @@ def test_the_gif_palette_is_chosen_from_colours_cut_to_palette_bits_and_maps_the
     for f in frames:
         enc.write(f)
     enc.close()
-    mask, centre = encode.palette_cut()
-    assert encode.PALETTE_BITS < 8 and bin(mask).count("1") == encode.PALETTE_BITS
-    make = f"stats_mode=diff:max_colors={encode.GIF_COLOURS}"
-
-    def two_inputs(stats: list[np.ndarray], name: str) -> bytes:
-        (tmp_path / "stats.raw").write_bytes(b"".join(f.tobytes() for f in stats))
-        (tmp_path / "frames.raw").write_bytes(b"".join(f.tobytes() for f in frames))
-        raw = ["-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "48x28", "-r", "20", "-i"]
-        cmd = [EXE, "-nostdin", "-loglevel", "error", *raw, str(tmp_path / "stats.raw"), *raw,
-               str(tmp_path / "frames.raw"), "-an", "-lavfi",
-               f"[0]palettegen={make}[p];[1][p]paletteuse=dither=bayer:bayer_scale=3", "-loop", "0", "-f", "gif",
-               str(tmp_path / name)]
-        subprocess.run(cmd, check=True)
-        return (tmp_path / name).read_bytes()
-
-    step = encode.palette_step(v)
+    mask, centre = palette.palette_cut()
+    assert palette.PALETTE_BITS < 8 and bin(mask).count("1") == palette.PALETTE_BITS
+    step = palette.palette_step(v)
     assert step == 4
-    cut = two_inputs([(f & mask) | centre for f in frames[::step]], "cut_ref.gif")
-    assert (tmp_path / "cut.gif").read_bytes() == cut
-    assert two_inputs(frames[::step], "uncut.gif") != cut
-    assert two_inputs([(f & mask) | centre for f in frames], "every.gif") != cut
+
+    def colours(stats: list[np.ndarray]) -> np.ndarray:
+        cmd = [EXE, "-nostdin", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", "48x28", "-r",
+               "20", "-i", "-", "-vf", f"palettegen=stats_mode=diff:max_colors={palette.GIF_COLOURS}", "-f",
+               "rawvideo", "-pix_fmt", "rgba", "-"]
+        rgba = np.frombuffer(subprocess.run(cmd, input=b"".join(f.tobytes() for f in stats), capture_output=True,
+                                            check=True).stdout, np.uint8).reshape(256, 4)
+        opaque = [tuple(c[:3]) for c in rgba if c[3] == 255]
+        return np.array(list(dict.fromkeys(opaque)), np.int64)  # in order, each once
+
+    pal = colours([(f & mask) | centre for f in frames[::step]])
+    assert not np.array_equal(colours(frames[::step]), pal) and not np.array_equal(
+        colours([(f & mask) | centre for f in frames]), pal)
+    bayer = np.array([[0]])
+    while len(bayer) < 8:  # the Bayer matrix: each level 4x the last, offset by 0, 2, 3, 1 in its quadrants
+        bayer = np.block([[4 * bayer, 4 * bayer + 2], [4 * bayer + 3, 4 * bayer + 1]])
+    d = np.tile(bayer // 8 - 4, (4, 6))[:28, :48, None]
+    want = []
+    for f in frames:
+        c = np.clip(f.astype(np.int64) + d, 0, 255)
+        want.append(pal[((c[:, :, None, :] - pal[None, None]) ** 2).sum(-1).argmin(-1)])  # argmin: the first
+    np.testing.assert_array_equal(decoded(tmp_path / "cut.gif").reshape(n, 28, 48, 3), np.stack(want))
 
 
 def area_reference(frame: np.ndarray, w: int, h: int) -> np.ndarray:

@@ -10,7 +10,7 @@ import pytest
 
 from conftest import ocr_line
 from render.config.scene import load
-from render.video import encode, gif, pipeline
+from render.video import encode, gif, palette, pipeline
 
 # A frame larger than the GIF's and a rate higher than its own, so the GIF has a canvas of its own; short, since
 # every render compiles its kernels.
@@ -110,12 +110,14 @@ def test_the_gif_frames_are_the_gif_canvas_frames(rigid):
     assert sorted(small) == sorted(set(shown))  # a GIF frame was drawn for exactly the video frames it shows
     frames = iio.imread(path)[..., :3]
     for k, f in enumerate(shown):
-        # palette quantisation (64 colours, dithered) is all that parts them
+        # palette quantisation (48 colours, dithered) is all that parts them
         assert psnr(frames[k], small[f]) >= 24.0, (k, psnr(frames[k], small[f]))
     # ... and they are not the video's frame shrunk: the text and the rods are drawn for this size
     assert all(s.shape == (h, w, 3) for s in small.values())
-    # the pipe: only frames of the GIF's size, one per GIF frame, then the end
-    assert piped[-1] is None and set(piped[:-1]) == {(h, w, 3)} and len(piped) - 1 == len(shown)
+    # the pipe: only frames of the GIF's size, every palette_step-th GIF frame (for the palette), then the end
+    step = palette.palette_step(scene.video)
+    assert step > 1 and piped[-1] is None and set(piped[:-1]) == {(h, w, 3)}
+    assert len(piped) - 1 == len(shown[::step])
 
 
 @pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000"])  # max compositing, and glow's hairlines

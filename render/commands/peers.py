@@ -264,13 +264,13 @@ def matplotlib_render(scene, out_file) -> float:
     import matplotlib.pyplot as plt
     from matplotlib.animation import FFMpegWriter, FuncAnimation
 
-    from ..video.encode import MP4_CRF, MP4_PRESET, x264_threads
+    from ..video import mp4
 
     t0 = time.perf_counter()
     fig, frame = matplotlib_figure(scene)
     matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
     writer = FFMpegWriter(fps=scene.video.fps, codec="libx264",
-                          extra_args=[*x264_threads(), "-preset", MP4_PRESET, "-crf", MP4_CRF, "-pix_fmt", "yuv420p"])
+                          extra_args=[*mp4.x264_threads(), "-preset", mp4.PRESET, "-crf", mp4.CRF, "-pix_fmt", "yuv420p"])
     FuncAnimation(fig, frame, frames=scene.frames, blit=False).save(str(out_file), writer=writer, dpi=100)
     plt.close(fig)
     return time.perf_counter() - t0

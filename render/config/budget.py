@@ -8,7 +8,7 @@ Three estimates, each against a limit stated as a share of what this machine has
   key or --budget, DEFAULT_LIMIT_S otherwise. A run of several scenes (`render A B`, `batch`, a
   comparison's panels) is held to the sum. Runs estimated over ANNOUNCE_S say so before they start;
 - memory: the state fields, the canvas and the frames a run holds at once: frames queued for ffmpeg, and
-  every GIF frame, which ffmpeg keeps until the palette is known at the end; `simulate` keeps every frame's
+  every GIF frame, kept until its palette is known at the end; `simulate` keeps every frame's
   state until it writes the file. Limit: MEMORY_FRACTION of the machine's physical memory;
 - output: bytes written (MP4 and GIF and a map's NAME.npz, or simulate's .npz). Limit: DISK_FRACTION of the free space where they go.
 Counts are Python ints (64-bit and beyond, never a wrapped 32-bit counter); the substeps per frame must fit
@@ -30,7 +30,8 @@ import sys
 from pathlib import Path
 
 from ..video import audio
-from ..video.encode import AUDIO_KBPS, QUEUE_FRAMES
+from ..video.encode import QUEUE_FRAMES
+from ..video.mp4 import AUDIO_KBPS
 from ..errors import SceneError
 from ..physics.integrators import AUTO_DT, check_substeps
 from ..physics.keys import BUDGET_MAX
@@ -45,7 +46,7 @@ FALLBACK_MEMORY = 8 << 30  # where the physical memory cannot be read
 MP4_BYTES_PER_PIXEL = 0.05
 GIF_BYTES_PER_PIXEL = 1.0
 NPZ_BYTES_PER_START = 48  # a map's data, uncompressed: 16 for the start, up to 24 for the angles, the masks
-GIF_BUFFER_BYTES_PER_PIXEL = 4  # ffmpeg holds each scaled GIF frame as RGB32 until palettegen has seen all
+GIF_BUFFER_BYTES_PER_PIXEL = 3  # the render keeps each GIF frame (RGB) until its palette is known (palette.py)
 
 
 def check(scene, system, out: Path | None, simulate: bool = False):
@@ -196,8 +197,8 @@ def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
              "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept,
              "video.duration": sound}
     detail = (f"state {size(state)}, canvas and queued frames {size(canvas + queued)}, "
-              f"GIF frames held by ffmpeg {size(gif)}" + (f", the variants' states at every frame {size(kept)}"
-                                                         if kept else ""))
+              f"GIF frames held for its palette {size(gif)}" + (
+                  f", the variants' states at every frame {size(kept)}" if kept else ""))
     detail += f", the audio track being made {size(sound)}" if sound else ""
     return sum(terms.values()), max(terms, key=terms.get), detail
 
@@ -222,7 +223,7 @@ def output(scene, system, simulate: bool) -> tuple[int, str, str]:
 
 
 def gif_frames(scene) -> int:
-    """Frames of the GIF: ffmpeg's fps filter resamples to min(gif_fps, fps) (see encode.gif_args)."""
+    """Frames of the GIF: ffmpeg's fps filter resamples to min(gif_fps, fps) (see render/video/gif.py)."""
     v = scene.video
     return math.ceil(min(v.gif_fps, v.fps) * scene.frames / v.fps - 1e-9)
 

@@ -6,14 +6,14 @@ and the same phase, so they add up to one clear, gliding tone; as the pendulums 
 two octaves and their sum becomes a dense, noisy cluster: the spread is heard as the tone breaking up.
 
 Pure numpy and no randomness: the same angles give the same samples (and the angles are the same at any
-thread count). The track is exactly as long as the video, frames/fps seconds; render/video/encode.py muxes it
+thread count). The track is exactly as long as the video, frames/fps seconds; render/video/mp4.py muxes it
 into the MP4 as AAC.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .encode import AUDIO_CODEC, AUDIO_KBPS, AUDIO_RATE
+from .mp4 import AUDIO_CODEC, AUDIO_KBPS, AUDIO_RATE
 from ..physics import registry
 
 VOICES = 64  # pendulums heard: a dense cluster once apart; synthesis costs grow with these, not with the fan

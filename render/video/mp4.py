@@ -1,0 +1,78 @@
+"""The MP4's settings: x264's preset, quality and threads, a finer quantiser where the HUD's text is, and the
+`audio` effect's track muxed into the finished file.
+
+Chosen on rigid_chaos (20 s, 1280x720, 60 fps), every setting encoding the same raw frames:
+- veryfast at crf 31 was 11.96 MB (crf 20 was 36 MB); crf is the lever for the picture. Near that size "fast"
+  gains 0.2-0.4 dB PSNR but made the whole render 2x slower on 2 cores (the render waits on the encoder);
+  "medium" costs 2x "veryfast" for 0.4 dB. tune=animation, aq-mode=3, weightp=2, a longer GOP and smaller
+  deadzones did not beat plain crf at equal size.
+- But crf 31 ghosts the HUD's digits (the last clock's strokes linger in P-frames): the columns beside the
+  pendulums' circle, where the HUD and a map's axes live (render/draw/hud.py), get a finer quantiser (x264's
+  regions of interest, ffmpeg's addroi, qoffset ROI_QOFFSET) and the rest crf 32. On the first 8 s: the same
+  bytes (1.31 vs 1.30 MB), the HUD's corners 38.8 dB instead of 33.3, the whole frame 30.18 dB instead of 30.22.
+"""
+import os
+import subprocess
+
+import imageio_ffmpeg
+import numpy as np
+
+from .atomic import temp_beside
+
+PRESET, CRF, ROI_QOFFSET = "veryfast", "32", -0.3
+ONE_THREAD_CPUS = 2  # see x264_threads()
+REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
+# The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
+# at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its 11.25 MB of picture.
+AUDIO_CODEC, AUDIO_RATE, AUDIO_KBPS = "aac", 48_000, 128
+
+
+def roi(video) -> list[str]:
+    """The columns left and right of the pendulums' circle, a finer quantiser there: the HUD's text reads."""
+    side = (video.width - 2 * REACH * video.height) / 2 / video.width
+    if side < 0.02:
+        return []
+    x, q = f"{side:.4f}", ROI_QOFFSET
+    return ["-vf", f"addroi=0:0:iw*{x}:ih:{q},addroi=iw*(1-{x}):0:iw*{x}:ih:{q}"]
+
+
+def x264_threads() -> list[str]:
+    """x264 on one thread where this process has at most ONE_THREAD_CPUS CPUs. Its own threads (frame threads
+    and a lookahead, 3 or more) cost a fifth more CPU: rigid_chaos's 1200 yuv420p frames took 15.8 s user +
+    1.2-1.7 s system at its default, 17.0-17.3 s at threads=2, 13.2 s + 0.9 s at one (ffmpeg from a file,
+    2-core Xeon with AVX-512, 2026-12-06). In a render the other core simulates and draws, so what counts on two
+    cores is the CPU time, not x264's own wall time: one thread took the whole render from 24.2-24.8 s to
+    22.5-22.8 s (alternating, two each), and after this round's cheaper drawing 24.5 s to 22.7 s (3
+    interleaved rounds). Where x264 is the render's slowest part, a fan light to draw, its own threads would be
+    quicker: one thread pays off while the rest of the render costs at least about 4/5 of x264's CPU time."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return ["-threads", "1"] if cpus <= ONE_THREAD_CPUS else []
+
+
+def args(video) -> list[str]:
+    """ffmpeg's output arguments for the MP4 (its frames come as yuv420p or rgb24)."""
+    return [*roi(video), "-c:v", "libx264", *x264_threads(), "-preset", PRESET, "-crf", CRF,
+            "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"]
+
+
+def mux(final, tmp, log, rate: int, samples: np.ndarray) -> int:
+    """Put the track into the finished MP4 at `tmp` (the temporary beside `final`): a second ffmpeg copies the
+    video's packets as they are (the same H.264 stream as without audio) and encodes the samples, int16
+    (S, 2) at `rate` Hz, piped to it, as AAC at AUDIO_RATE. No sound file is written; its output is another
+    temporary beside the final file, renamed onto `tmp`. Returns ffmpeg's exit status (its log: `log`)."""
+    out = temp_beside(final, suffix=".part")
+    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", "-i", tmp,
+           "-f", "s16le", "-ar", str(rate), "-ac", "2", "-i", "-", "-map", "0:v", "-map", "1:a",
+           "-c:v", "copy", "-c:a", AUDIO_CODEC, "-ar", str(AUDIO_RATE), "-b:a", f"{AUDIO_KBPS}k",
+           "-movflags", "+faststart", "-f", "mp4", out]
+    try:  # run() kills ffmpeg if we are interrupted while it works
+        code = subprocess.run(cmd, input=memoryview(np.ascontiguousarray(samples, "<i2")).cast("B"),
+                              stdout=subprocess.DEVNULL, stderr=log, start_new_session=True).returncode
+        if code:
+            out.unlink(missing_ok=True)
+            return code
+    except BaseException:
+        out.unlink(missing_ok=True)
+        raise
+    os.replace(out, tmp)  # atomic: at every moment exactly one temporary is ours to remove
+    return 0
