@@ -107,6 +107,7 @@ def convert(frame: np.ndarray) -> np.ndarray:
     out = np.empty(size(w, h), np.uint8)
     n, c = w * h, w * h // 4
     words = np.ascontiguousarray(frame).reshape(-1).view(np.uint32)
-    serial = ti.lang.impl.current_cfg().cpu_max_num_threads <= SERIAL_THREADS
+    cfg = ti.lang.impl.current_cfg()
+    serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_THREADS  # (on CUDA: one GPU thread)
     _convert(words, out[:n].view(np.uint32), out[n:n + c].view(np.uint16), out[n + c:].view(np.uint16), w, serial)
     return out
