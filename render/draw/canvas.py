@@ -57,8 +57,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
         self.one_band = self.banded and self.bands == 1  # its loops on the launching thread
         self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
-        self.serial = self.banded and cfg.cpu_max_num_threads <= 4  # bob_pixels: few points, one thread is cheaper
-        self.few = runtime.serial(self.n)  # a loop of a copy per pendulum runs serially (runtime.SERIAL_WORK)
+        self.few = runtime.serial(self.n * len(sim.LINKS))  # a loop over the points runs serially (SERIAL_WORK)
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`. Under a max they are kept as
         # the bytes they print as (the byte of a max is the max of the bytes: raster.to_byte), a quarter of the
         # memory the frame pass and the primitives read and write; but CUDA's atomic max takes 32-bit values.
@@ -178,9 +177,9 @@ class Canvas(Raster, Compose, runtime.Launcher):
 
     @ti.kernel
     def bob_pixels(self):
-        """The system's chain points in pixels, at frame times only. Serial where drawing is: a few thousand
-        points are less work than waking the thread pool."""
-        ti.loop_config(serialize=self.serial)
+        """The system's chain points in pixels, at frame times only; serial for a few thousand points, less
+        work than waking the thread pool."""
+        ti.loop_config(serialize=self.few)
         for i in range(self.n):
             pts = self.sim.points(self.sim.q[i])
             for j in ti.static(range(len(self.links))):
@@ -189,7 +188,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
     @ti.kernel
     def trail_path_pixels(self, slot: ti.i32):
         """Where the last bob is at a skipped frame (follow()), in pixels."""
-        ti.loop_config(serialize=self.serial)
+        ti.loop_config(serialize=self.few)
         for i in range(self.n):
             self.path[slot, i] = self.pixel(self.sim.points(self.sim.q[i]), self.tip)
 
@@ -211,7 +210,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
                             b = self.path[k, i]
                     self.segment(self.trail, self.lit, a, b, self.lw, c, w[2], w[3], True)
                     a = b
-        ti.loop_config(serialize=self.few)  # a copy per pendulum: less than waking the threads
+        ti.loop_config(serialize=self.few)
         for i in range(self.n):  # after every band has read where the bob was
             self.last[i] = self.pos[i, self.tip]
 

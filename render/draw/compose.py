@@ -39,7 +39,7 @@ class Compose:
         """The array a draw composes into: `out`, cleared unless it is the frame drawn last; a new zeroed one
         for None."""
         if out is None:
-            out = np.zeros((self.h, self.w, 3), np.uint8)
+            out = self.new_frame()
         elif out is not self.kept:
             out.fill(0)
         self.kept = out
