@@ -70,7 +70,8 @@ class _Target:
         self.planar = planar  # fed yuv420p (render/video/yuv.py), not rgb24
         self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
         self.small = small  # the GIF's (width, height): it is fed frames of that size only
-        self.kept: list | None = None  # a GIF's frames, for its palette (then fed every step-th frame)
+        self.kept: list | None = None  # a GIF's frames, mapped to its palette at the end (Encoder._gif)
+        self.step, self.rate = 1, None  # then every step-th is fed, for the palette; the GIF's frames a second
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
         try:
