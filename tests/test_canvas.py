@@ -78,3 +78,21 @@ def test_a_frame_drawn_into_that_is_not_the_last_one_is_cleared_first():
         if f == 20:
             break
     np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("name", ["rigid_chaos", "triple_chaos", "elastic_fan"])
+def test_a_layer_of_bytes_gives_the_frames_a_layer_of_floats_gives(name, monkeypatch):
+    """The byte of a max is the max of the bytes, to the bit: over 12 s of chaos, with trails and the HUD, in an
+    f64 runtime (where a primitive's colour times its coverage is an f64 value, rounded to the f32 a layer of
+    floats holds before its byte is taken)."""
+    scene = load(name, ["video.width=320", "video.height=180", "video.fps=30", "video.duration=12"])
+    runs = []
+    for byte_layer in (False, True):
+        monkeypatch.setattr(canvas_module, "BYTE_LAYER", byte_layer)
+        run = Run(scene)
+        canvas = Canvas(scene, run.sim)
+        assert canvas.rgb.dtype == (canvas_module.ti.u8 if byte_layer else canvas_module.ti.f32)
+        frames = [canvas.draw().tobytes() for _ in run.frames()]
+        runs.append(frames)
+    bad = [f for f, (a, b) in enumerate(zip(*runs)) if a != b]
+    assert len(runs[1]) == scene.frames and not bad, f"{len(bad)} frames differ, the first {bad[:1]}"

@@ -25,6 +25,10 @@ TILE = 8  # pixels per tile side for compositing: small enough to hug thin trail
 # 1.84 / 1.84; triple_chaos (216k) 5.21 / 5.96 and 4.63 / 4.63; rainbow_1000 (1.44M) 8.08 / 9.73 and 10.38 /
 # 10.27. And in a render on two cores the encoders hold the other one.
 BANDED_WORK = 720_000
+# Under a max the layer of rods, coils and bobs holds the bytes they print as (the byte of a max is the max of
+# the bytes: raster.to_byte), a quarter of the memory the frame pass and the primitives read and write; False
+# keeps floats, as CUDA's atomic max needs (32-bit values). tests/test_canvas.py holds both to the same frames.
+BYTE_LAYER = True
 
 
 @ti.data_oriented
@@ -58,10 +62,8 @@ class Canvas(Raster, Compose, runtime.Launcher):
         self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
         self.few = runtime.serial(self.n * len(sim.LINKS))  # a loop over the points runs serially (SERIAL_WORK)
-        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn`. Under a max they are kept as
-        # the bytes they print as (the byte of a max is the max of the bytes: raster.to_byte), a quarter of the
-        # memory the frame pass and the primitives read and write; but CUDA's atomic max takes 32-bit values.
-        self.rgb = runtime.field("canvas.frame", ti.u8 if self.banded and not self.glowing else light,
+        # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn` (BYTE_LAYER)
+        self.rgb = runtime.field("canvas.frame", ti.u8 if BYTE_LAYER and self.banded and not self.glowing else light,
                                  (self.h, self.w), 3, TILE)
         self.drawn = runtime.field("canvas.frame_tiles", ti.i32, (self.ty, self.tx))
         self.section, area = None, self.w  # the pendulums' width of the frame: all of it, or left of the section

@@ -84,8 +84,10 @@ class Raster:
                 if ti.static(not self.banded):
                     ti.atomic_max(buf[y, x][k], c[k])
                 elif ti.static(buf.dtype == ti.u8):  # a layer of bytes: the byte of the max
+                    # c is f64 in an f64 runtime (Python floats are its default_fp): rounded to the f32 a
+                    # layer of floats held, so that its byte is that layer's to the bit
                     old = ti.cast(buf[y, x][k], ti.i32)
-                    buf[y, x][k] = ti.cast(ti.max(old, ti.cast(to_byte(c[k]), ti.i32)), ti.u8)
+                    buf[y, x][k] = ti.cast(ti.max(old, ti.cast(to_byte(ti.cast(c[k], ti.f32)), ti.i32)), ti.u8)
                 else:
                     buf[y, x][k] = ti.max(buf[y, x][k], c[k])
             tiles[y // self.TILE, x // self.TILE] = 1  # every writer stores the same 1: the race is harmless
