@@ -12,12 +12,16 @@ import ctypes
 import os
 import sys
 import threading
+import time
 
 import numpy as np
 
 from ..errors import SceneError
 
 DISPLAY_TIMEOUT_S = 5.0  # a display that has not answered by then will not: a local one answers in ms
+# A bare X server (Xvfb) resets when its last client leaves and refuses connections while it does (CI saw
+# XOpenDisplay fail on a live Xvfb once); a refusal is retried this long before the display is called absent.
+REFUSED_RETRY_S, REFUSED_PAUSE_S = 2.0, 0.05
 
 
 class NoDisplay(SceneError):
@@ -57,7 +61,11 @@ def check_display(suggest: str) -> XConnection:
     x11.XOpenDisplay.restype = ctypes.c_void_p
     x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
     x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    deadline = time.monotonic() + REFUSED_RETRY_S
     conn = open_display(x11, display)
+    while conn == 0 and time.monotonic() < deadline:
+        time.sleep(REFUSED_PAUSE_S)
+        conn = open_display(x11, display)
     if conn is None:
         raise NoDisplay(f"show: display {display!r} did not answer within {DISPLAY_TIMEOUT_S:g} s; {hint}")
     if not conn:
