@@ -98,7 +98,7 @@ def test_same_preset_renders_byte_identical_frames_twice_and_across_thread_count
 
 
 @pytest.mark.parametrize("name", PRESETS)
-def test_every_preset_is_the_same_bytes_at_1_2_and_8_threads(preset_renders, name, tmp_path, monkeypatch):
+def test_every_preset_is_the_same_bytes_at_1_and_8_threads_as_on_all_cpus(preset_renders, name, tmp_path, monkeypatch):
     """The session's renders ran on all CPUs (2 in CI); each preset again on 1 thread and on 8 gives the same
     MP4 and GIF, byte for byte (every frame is in them, and the audio track), and the same raw frames."""
     monkeypatch.setattr(split, "cost", fixed_cost)
