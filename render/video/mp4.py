@@ -45,6 +45,7 @@ def x264_threads() -> list[str]:
     22.5-22.8 s (alternating, two each), and after this round's cheaper drawing 24.5 s to 22.7 s (3
     interleaved rounds). Where x264 is the render's slowest part, a fan light to draw, its own threads would be
     quicker: one thread pays off while the rest of the render costs at least about 4/5 of x264's CPU time."""
+    # config/options.py's usable_cores(), which sits a layer above this one (docs/architecture.md)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
     return ["-threads", "1"] if cpus <= ONE_THREAD_CPUS else []
 
