@@ -6,9 +6,10 @@ from work.
 
 Renders PRESET (default rigid_chaos) into a temporary folder as `pendulum render` does, with a timer around
 Source.next_frame (simulate and draw the video's frame, its HUD included), gif.Frames.frame (the GIF's own
-frame), yuv.convert (the MP4's yuv420p), the rest of Encoder.write (handing frames to the pipes: its wall
-time beyond its CPU time is waiting on an encoder) and Encoder.close (after the last frame). The stages nest:
-write's figures include the conversion's. Kernels compiled on a first run are in the first run's figures.
+frame), Hud.draw (within both), yuv.convert (the MP4's yuv420p), the rest of Encoder.write (handing frames
+to the pipes: its wall time beyond its CPU time is waiting on an encoder) and Encoder.close (after the last
+frame). The stages nest: the frames' figures include the HUD's, write's the conversion's. Kernels compiled
+on a first run are in the first run's figures.
 """
 import argparse
 import collections
@@ -20,10 +21,12 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from render.config.scene import load  # noqa: E402
+from render.draw.hud import Hud  # noqa: E402
 from render.video import encode, gif, pipeline, yuv  # noqa: E402
 
 STAGES = [(pipeline.Source, "next_frame", "video frame (simulate + draw + HUD)"),
           (gif.Frames, "frame", "GIF frame"),
+          (Hud, "draw", "HUD (the video's and the GIF's frames)"),
           (yuv, "convert", "yuv420p conversion"),
           (encode.Encoder, "write", "Encoder.write (conversion included)"),
           (encode.Encoder, "close", "Encoder.close")]

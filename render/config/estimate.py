@@ -45,7 +45,8 @@ RATES = {
     "draw_link_s": 17e-6,  # per drawn link (rod or spring, bob, trail) in a 720 px tall frame, ∝ its height:
     #                        10^4 pendulums drew in 187, 348 and 800 ms a frame at 360, 720 and 1440 px
     "hud_frame_s": 2e-3,  # the HUD, parallel since issue 27: 0.27-0.43 ms a 720p frame (`pendulum bench`'s
-    #                       hud_ms_720p, 2026-12-06), 0.64 ms beside x264 in a render; 8 ms when it was serial
+    #                       hud_ms_720p, 2026-12-06), 0.74-0.75 ms a call beside x264 in a render of rigid_chaos
+    #                       (`python benchmarks/render_threads.py`, twice); 8 ms when it was serial
     "mp4_frame_s": 3e-3, "mp4_pixel_s": 25e-9,  # x264: 16, 26 and 170 ms a frame at 360, 720 and 1440 px
     "gif_frame_s": 2e-3, "gif_pixel_s": 8e-9,  # the GIF's ffmpeg, per frame piped to it: 6.5, 8.9 and 46 ms
     "npz_byte_s": 2e-8,  # savez_compressed: about 50 MB/s
