@@ -66,6 +66,42 @@ def test_the_certified_run_has_the_watchdog_and_names_the_scenes_pendulum():
     assert "frame " in str(e.value) and "frame 0" not in str(e.value)
 
 
+
+@pytest.mark.parametrize("system, over", [("rigid", {}), ("rigid", {"precision": "f32"}), ("rigid", {"trig": "libm"}),
+                                          ("triple", {}), ("elastic", {"method": "symplectic_euler"})])
+def test_a_run_recorded_in_one_launch_is_the_frame_by_frame_run_to_the_bit(system, over):
+    """Run.record (the certificate's runs) steps every frame inside one kernel; Run.frames launches a frame at a
+    time. 37 pendulums: three groups of lanes, the last padded (one at a time under libm)."""
+    scene = make_scene(system, 37, pendulums=PEND, video={"fps": 10, "duration": 1.2}, integrator=over)
+    run = Run(scene)
+    one = run.record(scene.frames, watch=True)
+    t = run.sim.t
+    run.sim.restart()
+    each = np.empty_like(one)
+    for f in run.frames(energy=False):
+        run.sim.q_into(each, f)
+    assert run.sim.t == pytest.approx(t, rel=1e-12) and one.shape == (scene.frames, 37, run.sim.D)
+    assert np.array_equal(one, each) and not np.array_equal(one[1], one[0])
+    n, h = 2 * run.sim.substeps, run.sim.h / 2  # the shadow's way: a finer step
+    run.sim.restart()
+    fine = run.record(scene.frames, n, h)
+    run.sim.restart()
+    for _ in run.frames(substeps=n, h=h, energy=False):
+        pass
+    assert np.array_equal(fine[-1], run.sim.q.to_numpy().reshape(37, -1)) and not np.array_equal(fine, one)
+
+
+def test_a_recorded_run_that_blows_up_names_the_frame_and_pendulum_the_watchdog_names():
+    scene = make_scene("elastic", 8, **BLOWS_UP)
+    run = Run(scene)
+    with pytest.raises(SimulationError) as each:
+        for f in run.frames(energy=False):
+            pass
+    run.sim.restart()
+    with pytest.raises(SimulationError) as one:
+        run.record(scene.frames, watch=True)
+    assert str(one.value) == str(each.value) and "blew up" in str(one.value)
+
 def test_where_the_watchdog_is_off_a_blow_up_is_a_result():
     """The pilots and the measurements (quality.py, flagship.py) read a blow-up as a broken run."""
     scene = make_scene("elastic", 8, **BLOWS_UP)

@@ -16,13 +16,14 @@ import taichi as ti
 
 from . import crossings, runtime, steps
 from .plan import Plan
+from .recording import Recording
 from .sincos import sincos
 from ..errors import SimulationError
 
 BLOWN = 100.0  # a relative energy drift this large is a blow-up, not a drift
 
 
-class System(Plan, runtime.Launcher):
+class System(Plan, Recording, runtime.Launcher):
     """Base of the systems' @ti.data_oriented classes."""
 
     def __init__(self, scene, subset=None, allocate: bool = True):
@@ -139,10 +140,26 @@ class System(Plan, runtime.Launcher):
 
     @ti.kernel
     def advance(self, substeps: ti.i32, h: float, serial: ti.template()):
-        """All pendulums `substeps` steps of h on, in groups of `chunk`: the state stays in registers and on the
-        stack for the whole frame, and is read and written once.
+        """All pendulums `substeps` steps of h on, in groups of `chunk` (advance_group); advance_libm's one at a
+        time where the scene pins libm's sin/cos."""
+        S = ti.static(runtime.SPREAD)
+        ti.loop_config(serialize=serial)
+        for t in range(self.groups * S):  # blocks of 4 groups for the threads, not 512 (runtime.SPREAD)
+            if t % S == 0:
+                self.advance_group(t // S, substeps, h)
 
-        Each group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
+    @ti.kernel
+    def advance_libm(self, substeps: ti.i32, h: float, serial: ti.template()):
+        ti.loop_config(serialize=serial)
+        for i in range(self.n):
+            self.advance_one(i, substeps, h)
+
+    @ti.func
+    def advance_group(self, g, substeps, h):
+        """Group g's pendulums `substeps` steps of h on: the state stays in registers and on the stack for the
+        whole frame, and is read and written once.
+
+        The group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
         stack array rather than chunk·D scalars), and each substep is a loop over those columns that steps one
         pendulum (a D × 1 lane matrix) at a time. With no call and no branch on values in the step, LLVM's
         loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction (16 in two AVX-512 registers where
@@ -150,54 +167,47 @@ class System(Plan, runtime.Launcher):
         pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
         at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
         B = ti.static(self.chunk)
-        S = ti.static(runtime.SPREAD)
-        ti.loop_config(serialize=serial)
-        for t in range(self.groups * S):  # blocks of 4 groups for the threads, not 512 (runtime.SPREAD)
-            if t % S == 0:
-                g = t // S
-                Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
-                for lane in range(B):
-                    i = ti.min(g * B + lane, self.n - 1)
-                    Q[:, lane], V[:, lane] = self.q[i], self.v[i]
-                Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
-                if ti.static(self.poincare):
-                    for lane in range(B):
-                        if g * B + lane < self.n:
-                            self.crossed[g * B + lane] = 0
-                for s in range(substeps):
-                    if ti.static(self.poincare):
-                        Q0, V0 = Q, V
-                    for lane in range(B):  # the loop LLVM vectorises
-                        q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
-                        Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
-                    if ti.static(self.poincare):  # a loop of its own: its branch leaves the step's SIMD
-                        for lane in range(B):
-                            crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
-                                             ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
-                                             ti.Matrix.cols([V[:, lane]]), h)
-                for lane in range(B):
-                    i = g * B + lane
-                    if i < self.n:
-                        self.q[i], self.v[i] = Q[:, lane], V[:, lane]
-                        self.watch(i, Q[:, lane], V[:, lane])
-
-    @ti.kernel
-    def advance_libm(self, substeps: ti.i32, h: float, serial: ti.template()):
-        """advance for scenes that pin libm's sin/cos: one pendulum per iteration, as before the chunks (libm
-        calls do not vectorise), so its results are the earlier releases' to the bit (LLVM merges sin and cos
-        differently in the chunked loop, and in f32 from upright those bits decide the chaos)."""
-        ti.loop_config(serialize=serial)
-        for i in range(self.n):
-            q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
+        Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
+        for lane in range(B):
+            i = ti.min(g * B + lane, self.n - 1)
+            Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+        Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
+        if ti.static(self.poincare):
+            for lane in range(B):
+                if g * B + lane < self.n:
+                    self.crossed[g * B + lane] = 0
+        for s in range(substeps):
             if ti.static(self.poincare):
-                self.crossed[i] = 0
-            for s in range(substeps):
-                q0, v0 = q, v
-                q, v = steps.step(self, q, v, h)
-                if ti.static(self.poincare):
-                    crossings.detect(self, i, s, q0, v0, q, v, h)
-            self.q[i], self.v[i] = q[:, 0], v[:, 0]
-            self.watch(i, q, v)
+                Q0, V0 = Q, V
+            for lane in range(B):  # the loop LLVM vectorises
+                q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+            if ti.static(self.poincare):  # a loop of its own: its branch leaves the step's SIMD
+                for lane in range(B):
+                    crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
+                                     ti.Matrix.cols([V0[:, lane]]), ti.Matrix.cols([Q[:, lane]]),
+                                     ti.Matrix.cols([V[:, lane]]), h)
+        for lane in range(B):
+            i = g * B + lane
+            if i < self.n:
+                self.q[i], self.v[i] = Q[:, lane], V[:, lane]
+                self.watch(i, Q[:, lane], V[:, lane])
+
+    @ti.func
+    def advance_one(self, i, substeps, h):
+        """Pendulum i alone, as before the chunks, for scenes that pin libm's sin/cos (libm calls do not
+        vectorise), so its results are the earlier releases' to the bit (LLVM merges sin and cos differently in
+        the chunked loop, and in f32 from upright those bits decide the chaos)."""
+        q, v = ti.Matrix.cols([self.q[i]]), ti.Matrix.cols([self.v[i]])
+        if ti.static(self.poincare):
+            self.crossed[i] = 0
+        for s in range(substeps):
+            q0, v0 = q, v
+            q, v = steps.step(self, q, v, h)
+            if ti.static(self.poincare):
+                crossings.detect(self, i, s, q0, v0, q, v, h)
+        self.q[i], self.v[i] = q[:, 0], v[:, 0]
+        self.watch(i, q, v)
 
     @ti.func
     def watch(self, i, q, v):
@@ -225,26 +235,6 @@ class System(Plan, runtime.Launcher):
         ti.atomic_max(self.drift[None], ti.abs(d))
         if not ti.abs(d) < 1e30:
             ti.atomic_min(self.bad[None], i)
-
-    @ti.kernel
-    def q_into(self, out: ti.types.ndarray(dtype=ti.f64, ndim=3), f: ti.i32):
-        """q into out[f] of an (frames, N, D) float64 array: what q.to_numpy() reads, without a new array and a
-        copy every frame. A read-out, like to_numpy, so not in the log of kernels (runtime.Launcher)."""
-        ti.loop_config(serialize=True)  # a certificate's subsample or lattice: fewer than waking threads costs
-        for i in range(self.n):
-            for d in ti.static(range(self.D)):
-                out[f, i, d] = ti.cast(self.q[i][d], ti.f64)
-
-    @ti.kernel
-    def rows_into(self, out: ti.types.ndarray(dtype=ti.f64, ndim=3), f: ti.i32,
-                  rows: ti.types.ndarray(dtype=ti.i64, ndim=1)):
-        """q of the pendulums `rows` into out[f] of a (frames, len(rows), D) float64 array: the audio track's
-        voices (render/video/audio.py). q.to_numpy() there, a parallel launch and a new array of the whole fan,
-        took 319 us a frame of rigid_chaos, this 79 us (2-core Xeon, 2026-12-06)."""
-        ti.loop_config(serialize=True)
-        for r in range(rows.shape[0]):
-            for d in ti.static(range(self.D)):
-                out[f, r, d] = ti.cast(self.q[rows[r]][d], ti.f64)
 
     # --------------------------------------------------------------- host side (for render/physics/stepper.py)
     def measure_energy(self, first: bool = False):

@@ -104,13 +104,9 @@ def trajectory(scene, indices: np.ndarray, arch: str, threads=None, frames: int 
 def record(run: Run, frames: int, substeps: int | None = None, h: float | None = None,
            watch: bool = False) -> np.ndarray:
     """From the state it stands in, `substeps` steps of h per frame (default: the scene's): the states at
-    every frame time, in float64. watch: the NaN watchdog raises on a blow-up (the certified run's); without,
-    a blow-up is a result. No energy is measured: the render's own run watches it."""
-    out = np.empty((frames, run.sim.n, run.sim.D))
-    # one launch a frame into `out`, not q.to_numpy()'s new array and copy (docs/performance.md)
-    for f in run.frames(frames, substeps=substeps, h=h, energy=False, watch=watch):
-        run.sim.q_into(out, f)
-    return out
+    every frame time, in float64, in one launch (Run.record). watch: a blow-up raises (the certified run's);
+    without, it is a result. No energy is measured: the render's own run watches it."""
+    return run.record(frames, substeps, h, watch)
 
 
 def faithful_times(errors: np.ndarray, fps: int, duration: float) -> np.ndarray:
