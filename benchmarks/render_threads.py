@@ -2,7 +2,7 @@
 time and in this thread's CPU time, so that waiting (on x264's pipe, or for a core x264 holds) shows apart
 from work.
 
-    .venv/bin/python benchmarks/render_threads.py [PRESET] [--set KEY=VALUE]...
+    .venv/bin/python benchmarks/render_threads.py [PRESET] [--warm] [--set KEY=VALUE]...
 
 Renders PRESET (default rigid_chaos) into a temporary folder as `pendulum render` does, with a timer around
 Source.next_frame (simulate and draw the video's frame, its HUD included), gif.Frames.frame (the GIF's own
@@ -10,11 +10,18 @@ frame), Hud.draw (within both), yuv.convert (the MP4's yuv420p), the rest of Enc
 to the pipes: its wall time beyond its CPU time is waiting on an encoder) and Encoder.close (after the last
 frame). The stages nest: the frames' figures include the HUD's, write's the conversion's. Kernels compiled
 on a first run are in the first run's figures.
+
+Then the render's timeline, in seconds from its start: when the first frame reached the Encoder, when the
+last one had been handed over, when each ffmpeg process exited (x264's first, then the GIF's palettegen;
+the GIF's writer and the audio's mux come after) and when the render returned. --warm renders one frame
+first, in the same process, as `pendulum bench` does before its timed render (Taichi started, its kernels
+loaded).
 """
 import argparse
 import collections
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -44,25 +51,57 @@ def timed(fn, totals):
     return wrapper
 
 
+def timeline(marks: dict):
+    """Wrap the Encoder so that the render's milestones go into marks (name -> perf_counter time)."""
+    write, close = encode.Encoder.write, encode.Encoder.close
+
+    def timed_write(self, *args, **kwargs):
+        marks.setdefault("first frame handed to the Encoder", time.perf_counter())
+        try:
+            return write(self, *args, **kwargs)
+        finally:
+            marks["last frame handed over"] = time.perf_counter()
+
+    def timed_close(self, *args, **kwargs):
+        def exited(proc, name):
+            proc.wait()
+            marks[f"{name} exited"] = time.perf_counter()
+
+        for t in self.targets:
+            name = f"ffmpeg for {t.final.name}" + (" (palettegen)" if t.kept is not None else "")
+            threading.Thread(target=exited, args=(t.proc, name), daemon=True).start()
+        return close(self, *args, **kwargs)
+
+    encode.Encoder.write, encode.Encoder.close = timed_write, timed_close
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("preset", nargs="?", default="rigid_chaos")
+    ap.add_argument("--warm", action="store_true", help="render one frame first, as pendulum bench does")
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(argv)
     scene = load(args.preset, args.overrides)
-    stats = collections.defaultdict(lambda: [0.0, 0.0, 0])
-    for owner, name, label in STAGES:
-        setattr(owner, name, timed(getattr(owner, name), stats[label]))
     with tempfile.TemporaryDirectory(prefix="render-threads-") as tmp:
+        if args.warm:
+            pipeline.render(scene.replace(video={"duration": 1.0 / scene.video.fps}), Path(tmp) / "warm")
+        stats, marks = collections.defaultdict(lambda: [0.0, 0.0, 0]), {}
+        for owner, name, label in STAGES:
+            setattr(owner, name, timed(getattr(owner, name), stats[label]))
+        timeline(marks)
         wall, cpu = time.perf_counter(), time.process_time()
         meta = pipeline.render(scene, Path(tmp))
-        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+        marks["render returned"] = end = time.perf_counter()
+        wall, cpu = end - wall, time.process_time() - cpu
     print(f"{args.preset}: pipeline.render {wall:.2f} s wall, {cpu:.2f} s CPU of this process (all its threads)")
     print(f"timings_s: {meta['timings_s']}")
     print("| stage | calls | wall s | main thread CPU s | wall ms a call |\n|---|---:|---:|---:|---:|")
     for _, _, label in STAGES:
         w, c, n = stats[label]
         print(f"| {label} | {n} | {w:.2f} | {c:.2f} | {1e3 * w / max(n, 1):.2f} |")
+    start = end - wall
+    print("timeline, s from the render's start: " + ", ".join(
+        f"{k} {v - start:.2f}" for k, v in sorted(marks.items(), key=lambda kv: kv[1])))
     return 0
 
 
