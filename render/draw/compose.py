@@ -104,43 +104,47 @@ class Compose:
 
     @ti.func
     def fade_tile(self, out: ti.template(), ty, tx, layer: ti.template()):
-        """A tile with a trail: in three loops over its pixels. The trail (and the layer) are read into arrays on
-        the stack, the bytes and the faded trail are worked out there, then written back. Only the middle loop
-        touches no field or array argument, so it is the one LLVM vectorises (a store through a pointer it
-        cannot tell apart from the others keeps a loop over fields scalar). rigid_chaos's trails alone, 20 s on
-        one thread: 1.53 ms a frame where pixel by pixel they took 2.35, the same bytes (`python
-        benchmarks/draw_kernels.py rigid_chaos --seconds 20 --threads 1 --set 'effects=["trails"]'`, 2-core
-        Xeon, AVX-512). A pixel off the trail (0) fades to 0: no branch, and dark pixels stay dark."""
-        P = ti.static(self.TILE * self.TILE)
-        y0, x0 = ty * self.TILE, tx * self.TILE
-        c = ti.Matrix.zero(self.rgb.dtype, 3, P)
-        t = ti.Matrix.zero(ti.f32, 3, P)
-        for p in range(P):
-            y, x = y0 + p // self.TILE, x0 + p % self.TILE  # inside the fields: they are whole tiles
-            if ti.static(layer):
-                c[:, p] = self.rgb[y, x]
-                self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
-            t[:, p] = self.trail[y, x]
-        b = ti.Matrix.zero(ti.i32, 3, P)
-        lit = ti.Vector.zero(ti.i32, P)
-        for p in range(P):  # the loop LLVM vectorises
-            for k in ti.static(range(3)):
-                if ti.static(layer):
-                    if ti.static(self.rgb.dtype == ti.u8):
-                        b[k, p] = ti.cast(c[k, p], ti.i32)
-                    else:
-                        b[k, p] = ti.cast(to_byte(c[k, p]), ti.i32)
-                faded = ti.cast(t[k, p] * self.decay, ti.f32)
-                b[k, p] = ti.max(b[k, p], ti.cast(to_byte(t[k, p]), ti.i32))
-                dark = to_byte(faded) == 0
-                lit[p] |= ti.cast(not dark, ti.i32)
-                t[k, p] = ti.select(dark, 0.0, faded)
+        """A tile with a trail, two of its rows (16 pixels) at a time, in three loops over their pixels: the trail
+        (and the layer) are read into arrays on the stack, the bytes and the faded trail are worked out there,
+        then written back. Only the middle loop touches no field or array argument, so it is the one LLVM
+        vectorises (a store through a pointer it cannot tell apart from the others keeps a loop over fields
+        scalar). rigid_chaos's trails alone, 20 s on one thread: 1.66 ms a frame where pixel by pixel they took
+        2.34-2.36, the same bytes (`python benchmarks/draw_kernels.py rigid_chaos --seconds 20 --threads 1 --set
+        'effects=["trails"]'`, 2-core Xeon, AVX-512). The whole tile at once was as quick but slow to compile: a
+        render from an empty kernel cache (`TI_OFFLINE_CACHE_FILE_PATH=$(mktemp -d) pendulum render rigid_chaos`)
+        took 23.0 s, two rows at a time 20.3 s, pixel by pixel 19.6-19.7 s. A pixel off the trail (0) fades to
+        0: no branch, and dark pixels stay dark."""
+        P = ti.static(2 * self.TILE)  # 16 lanes: one vector of f32 at AVX-512's width
         any_lit = 0
-        for p in range(P):
-            y, x = y0 + p // self.TILE, x0 + p % self.TILE
-            self.trail[y, x] = t[:, p]
-            any_lit |= lit[p]
-            if y < self.h and x < self.w:
+        for half in range(self.TILE // 2):
+            y0, x0 = ty * self.TILE + 2 * half, tx * self.TILE
+            c = ti.Matrix.zero(self.rgb.dtype, 3, P)
+            t = ti.Matrix.zero(ti.f32, 3, P)
+            for p in range(P):
+                y, x = y0 + p // self.TILE, x0 + p % self.TILE  # inside the fields: they are whole tiles
+                if ti.static(layer):
+                    c[:, p] = self.rgb[y, x]
+                    self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
+                t[:, p] = self.trail[y, x]
+            b = ti.Matrix.zero(ti.i32, 3, P)
+            lit = ti.Vector.zero(ti.i32, P)
+            for p in range(P):  # the loop LLVM vectorises
                 for k in ti.static(range(3)):
-                    out[y, x, k] = ti.cast(b[k, p], ti.u8)
+                    if ti.static(layer):
+                        if ti.static(self.rgb.dtype == ti.u8):
+                            b[k, p] = ti.cast(c[k, p], ti.i32)
+                        else:
+                            b[k, p] = ti.cast(to_byte(c[k, p]), ti.i32)
+                    faded = ti.cast(t[k, p] * self.decay, ti.f32)
+                    b[k, p] = ti.max(b[k, p], ti.cast(to_byte(t[k, p]), ti.i32))
+                    dark = to_byte(faded) == 0
+                    lit[p] |= ti.cast(not dark, ti.i32)
+                    t[k, p] = ti.select(dark, 0.0, faded)
+            for p in range(P):
+                y, x = y0 + p // self.TILE, x0 + p % self.TILE
+                self.trail[y, x] = t[:, p]
+                any_lit |= lit[p]
+                if y < self.h and x < self.w:
+                    for k in ti.static(range(3)):
+                        out[y, x, k] = ti.cast(b[k, p], ti.u8)
         return any_lit
