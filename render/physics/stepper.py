@@ -1,4 +1,6 @@
-"""The frame loop: every run that steps a system from frame time to frame time steps through Run.frames.
+"""The frame loop: every run that steps a system from frame time to frame time steps through Run.frames, or,
+where nothing is drawn or measured between frames (the certificate's runs), through Run.record, the same
+steps in one launch.
 
 A Run starts Taichi for its scene (runtime.init: nothing is restarted when it already runs with those
 settings), then builds the scene's system in it, so no caller has to remember to start Taichi first, or in
