@@ -184,6 +184,17 @@ def _without_remarks(text: bytes, ok: bool) -> bytes:
 def _own_cache(sub: str):
     """Point Taichi's offline cache (TI_OFFLINE_CACHE_FILE_PATH, else Taichi's default) at its subfolder sub;
     a child process inherits the path and keeps it."""
+    os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = _in_cache(sub)
+
+
+def _in_cache(sub: str) -> str:
     path = os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path
-    if os.path.basename(os.path.normpath(path)) != sub:
-        os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = os.path.join(path, sub)
+    return path if os.path.basename(os.path.normpath(path)) == sub else os.path.join(path, sub)
+
+
+def cache_folder() -> str:
+    """The folder Taichi's offline cache writes this process's kernels to (or a child's it starts): apply()'s
+    subfolder where it sets a width, else the cache itself."""
+    width = planned()
+    return _in_cache(f"llvm-vf{width}") if width else (
+        os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path)
