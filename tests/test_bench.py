@@ -206,27 +206,36 @@ def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):
 
 def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tmp_path):
     """A phase whose process added a kernel to the offline cache timed its compiles: it runs once more and
-    that run is kept (render/commands/bench_process.py); a phase that found every kernel runs once."""
+    that run is kept (render/commands/bench_process.py); a phase that found every kernel runs once, and so does
+    every phase of a quick run, whose report says which were timed with compiles."""
+    from types import SimpleNamespace
+
     from render.commands import bench_process
     from render.physics import vector_width
     cache, runs = tmp_path / "cache", []
     cache.mkdir()
     monkeypatch.setattr(vector_width, "cache_folder", lambda: str(cache))
 
-    def phase(name, args, tmp):  # the first run compiles two kernels, as Taichi writes them at its exit
+    def phase(name, args, tmp):  # the first run of each phase compiles two kernels, written at its exit
         runs.append(name)
-        for k in range(2 if len(runs) == 1 else 0):
-            (cache / f"T{k}.tic").write_bytes(b"")
+        if runs.count(name) == 1:
+            for k in range(2):
+                (cache / f"T{name}{k}.tic").write_bytes(b"")
         return {"wall_s": 20.0 - len(runs)}
     monkeypatch.setattr(bench_process, "_run_phase", phase)
-    assert bench_process.run_phase("e2e", None, tmp_path) == {"wall_s": 18.0, "compiled_first_run": 2}
-    assert bench_process.run_phase("hud", None, tmp_path) == {"wall_s": 17.0} and runs == ["e2e", "e2e", "hud"]
+    full, quick = SimpleNamespace(quick=False), SimpleNamespace(quick=True)
+    assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 18.0, "compiled": 2, "rerun": True}
+    assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 17.0, "compiled": 0, "rerun": False}
+    assert bench_process.run_phase("hud", quick, tmp_path) == {"wall_s": 16.0, "compiled": 2, "rerun": False}
+    assert runs == ["e2e", "e2e", "e2e", "hud"]
     res = fake_results()
-    assert "Run twice" not in bench_report.markdown(bench_report.summarise(res, True, 1.0, 2.0, [0.5] * 3))
-    res["e2e"]["compiled_first_run"] = 2
+    assert "compile" not in bench_report.markdown(bench_report.summarise(res, True, 1.0, 2.0, [0.5] * 3))
+    res["e2e"].update(compiled=2, rerun=True)
+    res["hud"].update(compiled=8, rerun=False)
     rep = bench_report.summarise(res, True, 1.0, 2.0, [0.5] * 3)
-    assert rep["compiled_first_run"] == {"e2e": 2} and "compiled kernels (how many): e2e (2)." in \
-        bench_report.markdown(rep)
+    assert rep["compiled"] == {"e2e": 2, "hud": 8} and rep["rerun"] == ["e2e"]
+    md = bench_report.markdown(rep)
+    assert "compiled kernels (how many): e2e (2)." in md and "does not run a phase again): hud (8)." in md
 
 
 def test_repeat_must_be_a_positive_count(capsys, tmp_path):

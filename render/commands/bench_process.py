@@ -15,18 +15,19 @@ from ..errors import SimulationError
 
 
 def run_phase(name: str, args, tmp: Path) -> dict:
-    """One phase in a subprocess; its result plus the peak resident memory of its process tree. A phase that
-    compiled a kernel (Taichi's offline cache gained a file: it writes them when the process ends) runs once
-    more, and that run is the one kept: its warm-ups cannot load what the timed part compiles, since a kernel's
-    cache key holds every field made before it in the process (render/commands/bench.py's e2e phase). Its
-    result says how many kernels the first run compiled."""
+    """One phase in a subprocess; its result plus the peak resident memory of its process tree, and `compiled`,
+    how many kernels it compiled (Taichi's offline cache gained a file: it writes them when the process ends).
+    Then, unless --quick (a smoke run), the phase runs once more and that run is kept (`rerun`): its warm-ups
+    cannot load what the timed part compiles, since a kernel's cache key holds every field made before it in
+    the process (render/commands/bench.py's e2e phase)."""
     before = cached_kernels()
     out = _run_phase(name, args, tmp)
     compiled = len(cached_kernels() - before)
-    if compiled:
+    rerun = bool(compiled) and not args.quick
+    if rerun:
         print(f"bench: {name} compiled {compiled} kernels; again, with them cached ...", file=sys.stderr, flush=True)
-        out = {**_run_phase(name, args, tmp), "compiled_first_run": compiled}
-    return out
+        out = _run_phase(name, args, tmp)
+    return {**out, "compiled": compiled, "rerun": rerun}
 
 
 def cached_kernels() -> set[str]:

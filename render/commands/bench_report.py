@@ -63,7 +63,8 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "spread": {**peers.spreads(rows, mpl), **{f"rigid_rk4_peak_fraction.{p}": v["fraction"]
                                                      for p, v in pk.items()}},
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING},
-           "compiled_first_run": {k: v["compiled_first_run"] for k, v in res.items() if "compiled_first_run" in v}}
+           "compiled": {k: v["compiled"] for k, v in res.items() if v.get("compiled")},  # kernels, by phase
+           "rerun": [k for k, v in res.items() if v.get("rerun")]}
     rep.update({"hud_ms_per_frame": rep["hud_ms_720p"],  # the same figures, named as the first targets were
                 **{f"peak_flops_{p}": v["peak_gflops"] * 1e9 for p, v in pk.items()},
                 **{f"rigid_rk4_fraction_of_peak_{p}": v["fraction"]["value"] for p, v in pk.items()}})
@@ -134,9 +135,15 @@ def markdown(r: dict) -> str:
            f"{r['rounds']} interleaved rounds (ours, the peer, ours again, ...), with the range of the per-round "
            "ratios beside it.", "", "## Targets", ""]
     out += targets_table(r)
-    if r.get("compiled_first_run"):
-        out += ["", "Run twice, the second run's figures kept, since the first compiled kernels (how many): " +
-                ", ".join(f"{k} ({n})" for k, n in r["compiled_first_run"].items()) + "."]
+    compiled = r.get("compiled", {})
+    if compiled:
+        twice = [f"{k} ({n})" for k, n in compiled.items() if k in r["rerun"]]
+        once = [f"{k} ({n})" for k, n in compiled.items() if k not in r["rerun"]]
+        out += ["", " ".join(
+            (["Run twice, the second run's figures kept, since the first compiled kernels (how many): "
+              f"{', '.join(twice)}."] if twice else []) +
+            ([f"Timed with compiles in them (a quick run does not run a phase again): {', '.join(once)}."]
+             if once else []))]
     if missed:
         out += ["", f"Missed: {', '.join(missed)}. What limits it is profiled in benchmarks/README.md."]
     if r["quick"]:
