@@ -47,7 +47,8 @@ def reference(f: np.ndarray) -> np.ndarray:
     return np.concatenate([np.floor(p + 0.5).ravel() for p in planes])
 
 
-@pytest.mark.parametrize("w,h,seed", [(64, 36, 0), (128, 72, 1), (1280, 720, 2)])
+# 68 and 44: rows of 17 and 11 groups, a run of yuv.LANES and a short one, and a short one alone
+@pytest.mark.parametrize("w,h,seed", [(64, 36, 0), (128, 72, 1), (1280, 720, 2), (68, 36, 3), (44, 10, 4)])
 def test_matches_bt601_within_one_level(w, h, seed):
     f = frame(w, h, seed)
     got, want = yuv.convert(f).astype(int), reference(f)

@@ -2,10 +2,11 @@
 
 x264 codes yuv420p. Handed rgb24, ffmpeg converted every frame itself (swscale, before x264's threads) and read
 twice the bytes through the pipe. On the 2-core Xeon (AVX-512), rigid_chaos's 1200 frames at 720p from a file
-took ffmpeg 13.8-14.1 s of user CPU from rgb24 and 11.4-11.7 s from yuv420p, the same x264 settings; the kernel
-below took a median 1.15 ms a frame on two threads, 1.5 s for the 1200 (`python benchmarks/yuv_pipe.py`, two
-rounds). Whole renders of rigid_chaos took 14.5 and 15.0 s against 15.7 and 15.9 s before (`pendulum render
-rigid_chaos`, wall time, alternating).
+took ffmpeg 13.8-14.1 s of user CPU from rgb24 and 11.4-11.7 s from yuv420p, the same x264 settings
+(`python benchmarks/yuv_pipe.py`, two rounds, 2026-12-04). Whole renders of rigid_chaos took 14.5 and 15.0 s
+against 15.7 and 15.9 s before (`pendulum render rigid_chaos`, wall time, alternating). The kernel below takes
+a median 0.97 ms a frame (10th-90th percentile 0.75-1.13 ms), 1.16 s for the 1200; before its groups were
+staged on the stack, 1.50 ms and 1.65 s, the same bytes (the same script, one round each, 2026-12-06).
 
 The conversion is ffmpeg's default one for untagged RGB, BT.601 at limited range (Y 16..235, Cb and Cr
 16..240), in integer fixed point so that every CPU gives the same bytes. Y is swscale's within a level; chroma
@@ -46,13 +47,14 @@ def _round(v, shift: ti.template()):
     return (v + (1 << (shift - 1))) >> shift  # >> floors: adding half first rounds to nearest
 
 
-# Taichi's CPU threads take a parallel loop in blocks of at least 512 iterations (render/physics/runtime.py):
-# a loop over 360 rows of groups would run on one thread, so each row is cut into PIECES runs of groups.
-PIECES = 16
+# Groups converted at a time: 16 words of 32 bits, one AVX-512 register. Taichi's CPU threads take a parallel
+# loop in blocks of at least 512 iterations (render/physics/runtime.py), so the loop is over runs of groups, not
+# rows: 720p is 360 rows of 20 runs.
+LANES = 16
 # On two CPUs or fewer the loop runs on the launching thread: the conversion is bound by memory, and the thread
 # pool's wake-up cost CPU time that x264 needs on the other core. rigid_chaos's second 10 s of 720p frames,
 # from memory: 1.79 ms wall and 2.60 ms CPU a frame on two threads, 1.75 ms and 1.75 ms serial (2-core Xeon,
-# 2026-12-06, medians of 3 rounds).
+# 2026-12-06, medians of 3 rounds, the kernel before its groups were staged).
 SERIAL_THREADS = 2
 
 
@@ -62,40 +64,52 @@ def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(d
              serial: ti.template()):
     """Groups of 4×2 pixels: in each of its two rows 12 bytes of RGB are 3 words (the frame's rows are whole
     words since its width is a multiple of 4), out come a word of Y per row and two bytes each of Cb and Cr.
-    Most of a frame is black, and a black group is 6 loads and 4 stores. The arrays are flat: 2-D ndarray
-    indexing made the same loop 5 times slower."""
+    LANES groups of a row at a time: their words are read into an array on the stack, converted there in a loop
+    that touches no array argument (the one LLVM vectorises: a loop that stores through an ndarray stays
+    scalar, as in render/draw/compose.py's fade_tile), and written back. Most of a frame is black, and a run
+    of black groups is only read and written. The arrays are flat: 2-D ndarray indexing made the same loop 5
+    times slower."""
     gw = w // 4
     rows = cb2.shape[0] // gw  # rows of groups: half the frame's height
-    run = (gw + PIECES - 1) // PIECES
+    runs = (gw + LANES - 1) // LANES
     ti.loop_config(serialize=serial)
-    for t in range(rows * PIECES):
-        gy, piece = t // PIECES, t % PIECES
-        for gx in range(piece * run, ti.min(piece * run + run, gw)):
-            top = 2 * gy * 3 * gw + 3 * gx  # the group's first word in the top row; the bottom row 3 * gw on
-            words = ti.Vector([rgb[top + 3 * gw * r + k] for r, k in ti.static(ti.ndrange(2, 3))])
-            ci = gy * gw + gx
-            if words.max() == 0:
-                y4[2 * gy * gw + gx], y4[(2 * gy + 1) * gw + gx] = ti.u32(BLACK_Y), ti.u32(BLACK_Y)
-                cb2[ci], cr2[ci] = ti.u16(BLACK_C), ti.u16(BLACK_C)
-            else:
-                cb, cr = ti.u32(0), ti.u32(0)
+    for t in range(rows * runs):
+        gy, g0 = t // runs, (t % runs) * LANES
+        n = ti.min(LANES, gw - g0)
+        top = 2 * gy * 3 * gw + 3 * g0  # the first group's first word in the top row; the bottom row 3 * gw on
+        words = ti.Matrix.zero(ti.u32, 6, LANES)
+        lit = ti.u32(0)
+        for p in range(n):
+            for r, k in ti.static(ti.ndrange(2, 3)):
+                words[3 * r + k, p] = rgb[top + 3 * gw * r + 3 * p + k]
+                lit |= words[3 * r + k, p]
+        luma = ti.Matrix.zero(ti.u32, 2, LANES)
+        cb = ti.Vector.zero(ti.u32, LANES)
+        cr = ti.Vector.zero(ti.u32, LANES)
+        if lit == 0:
+            for p in range(LANES):
+                luma[0, p], luma[1, p], cb[p], cr[p] = ti.u32(BLACK_Y), ti.u32(BLACK_Y), ti.u32(BLACK_C), \
+                    ti.u32(BLACK_C)
+        else:
+            for p in range(LANES):  # the loop LLVM vectorises
                 sums = ti.Matrix.zero(ti.i32, 2, 3)  # channel sums of the group's left and right 2×2 blocks
                 for r in ti.static(range(2)):
-                    luma = ti.u32(0)
-                    for p in ti.static(range(4)):
-                        c = ti.Vector([_byte(words[3 * r + (3 * p + k) // 4], (3 * p + k) % 4)
+                    for q in ti.static(range(4)):
+                        c = ti.Vector([_byte(words[3 * r + (3 * q + k) // 4, p], (3 * q + k) % 4)
                                        for k in ti.static(range(3))])
                         for k in ti.static(range(3)):
-                            sums[p // 2, k] += c[k]
+                            sums[q // 2, k] += c[k]
                         v = 16 + _round(Y[0] * c[0] + Y[1] * c[1] + Y[2] * c[2], SHIFT)
-                        luma |= ti.cast(v, ti.u32) << (8 * p)
-                    y4[(2 * gy + r) * gw + gx] = luma
+                        luma[r, p] |= ti.cast(v, ti.u32) << (8 * q)
                 for b in ti.static(range(2)):  # a sum of 4 pixels: two more bits to shift away
                     u = 128 + _round(CB[0] * sums[b, 0] + CB[1] * sums[b, 1] + CB[2] * sums[b, 2], SHIFT + 2)
                     v = 128 + _round(CR[0] * sums[b, 0] + CR[1] * sums[b, 1] + CR[2] * sums[b, 2], SHIFT + 2)
-                    cb |= ti.cast(u, ti.u32) << (8 * b)
-                    cr |= ti.cast(v, ti.u32) << (8 * b)
-                cb2[ci], cr2[ci] = ti.cast(cb, ti.u16), ti.cast(cr, ti.u16)
+                    cb[p] |= ti.cast(u, ti.u32) << (8 * b)
+                    cr[p] |= ti.cast(v, ti.u32) << (8 * b)
+        for p in range(n):
+            ci = gy * gw + g0 + p
+            y4[2 * gy * gw + g0 + p], y4[(2 * gy + 1) * gw + g0 + p] = luma[0, p], luma[1, p]
+            cb2[ci], cr2[ci] = ti.cast(cb[p], ti.u16), ti.cast(cr[p], ti.u16)
 
 
 def convert(frame: np.ndarray) -> np.ndarray:
