@@ -214,7 +214,7 @@ def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tm
     from render.physics import vector_width
     cache, runs = tmp_path / "cache", []
     cache.mkdir()
-    monkeypatch.setattr(vector_width, "cache_folder", lambda: str(cache))
+    monkeypatch.setattr(vector_width, "cache_folder", lambda arch: str(cache))
 
     def phase(name, args, tmp):  # the first run of each phase compiles two kernels, written at its exit
         runs.append(name)
@@ -223,7 +223,7 @@ def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tm
                 (cache / f"T{name}{k}.tic").write_bytes(b"")
         return {"wall_s": 20.0 - len(runs)}
     monkeypatch.setattr(bench_process, "_run_phase", phase)
-    full, quick = SimpleNamespace(quick=False), SimpleNamespace(quick=True)
+    full, quick = SimpleNamespace(quick=False, arch="cpu"), SimpleNamespace(quick=True, arch="cpu")
     assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 18.0, "compiled": 2, "rerun": True}
     assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 17.0, "compiled": 0, "rerun": False}
     assert bench_process.run_phase("hud", quick, tmp_path) == {"wall_s": 16.0, "compiled": 2, "rerun": False}

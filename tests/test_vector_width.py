@@ -90,13 +90,15 @@ def test_the_elf_symbol_table_gives_the_address_the_dynamic_linker_gives():
 
 def test_width_zero_sets_nothing_and_keeps_the_cache(tmp_path):
     env = dict(os.environ, PENDULUM_VECTOR_WIDTH="0", TI_OFFLINE_CACHE_FILE_PATH=str(tmp_path))
-    code = ("import os, taichi; from render.physics import vector_width as v; before = v.cache_folder(); "
-            "print(v.planned(), v.apply(), os.environ['TI_OFFLINE_CACHE_FILE_PATH'], before)")
+    code = ("import os, taichi; from render.physics import vector_width as v; before = v.cache_folder('cpu'); "
+            "gpu = v.cache_folder('cuda'); "
+            "print(v.planned(), v.apply(), os.environ['TI_OFFLINE_CACHE_FILE_PATH'], before, gpu)")
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
-    assert r.stdout.split() == ["0", "0", str(tmp_path), str(tmp_path)], r.stderr
+    assert r.stdout.split() == ["0", "0", str(tmp_path), str(tmp_path), str(tmp_path)], r.stderr
     env["PENDULUM_VECTOR_WIDTH"] = "16"  # cache_folder() names, before apply(), the folder apply() then sets
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
-    assert r.stdout.split() == ["16", "16", str(tmp_path / "llvm-vf16"), str(tmp_path / "llvm-vf16")], r.stderr
+    assert r.stdout.split() == ["16", "16", str(tmp_path / "llvm-vf16"), str(tmp_path / "llvm-vf16"),
+                                str(tmp_path)], r.stderr  # runtime.init applies no width for CUDA
 
 
 def test_a_width_that_is_not_one_exits_2_with_one_line_and_writes_nothing(tmp_path):

@@ -20,9 +20,9 @@ def run_phase(name: str, args, tmp: Path) -> dict:
     Then, unless --quick (a smoke run), the phase runs once more and that run is kept (`rerun`): its warm-ups
     cannot load what the timed part compiles, since a kernel's cache key holds every field made before it in
     the process (render/commands/bench.py's e2e phase)."""
-    before = cached_kernels()
+    before = cached_kernels(args.arch)
     out = _run_phase(name, args, tmp)
-    compiled = len(cached_kernels() - before)
+    compiled = len(cached_kernels(args.arch) - before)
     rerun = bool(compiled) and not args.quick
     if rerun:
         print(f"bench: {name} compiled {compiled} kernels; again, with them cached ...", file=sys.stderr, flush=True)
@@ -30,11 +30,11 @@ def run_phase(name: str, args, tmp: Path) -> dict:
     return {**out, "compiled": compiled, "rerun": rerun}
 
 
-def cached_kernels() -> set[str]:
-    """The kernels in the offline cache the phases' processes use (empty if it does not exist yet)."""
+def cached_kernels(arch: str) -> set[str]:
+    """The kernels in the offline cache the phases' processes on `arch` use (empty if it does not exist yet)."""
     from ..physics import vector_width
     try:
-        return {f for f in os.listdir(vector_width.cache_folder()) if f.endswith(".tic")}
+        return {f for f in os.listdir(vector_width.cache_folder(arch)) if f.endswith(".tic")}
     except OSError:
         return set()
 

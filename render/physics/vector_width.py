@@ -187,14 +187,17 @@ def _own_cache(sub: str):
     os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = _in_cache(sub)
 
 
+def _cache_root() -> str:
+    return os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path
+
+
 def _in_cache(sub: str) -> str:
-    path = os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path
+    path = _cache_root()
     return path if os.path.basename(os.path.normpath(path)) == sub else os.path.join(path, sub)
 
 
-def cache_folder() -> str:
-    """The folder Taichi's offline cache writes this process's kernels to (or a child's it starts): apply()'s
-    subfolder where it sets a width, else the cache itself."""
-    width = planned()
-    return _in_cache(f"llvm-vf{width}") if width else (
-        os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path)
+def cache_folder(arch: str = "cpu") -> str:
+    """The folder Taichi's offline cache writes this process's kernels to, or a child's it starts on `arch`:
+    apply()'s subfolder where it sets a width (runtime.init applies it on the CPU only), else the cache itself."""
+    width = planned() if arch == "cpu" else 0
+    return _in_cache(f"llvm-vf{width}") if width else _cache_root()

@@ -47,9 +47,9 @@ def _round(v, shift: ti.template()):
     return (v + (1 << (shift - 1))) >> shift  # >> floors: adding half first rounds to nearest
 
 
-# Groups converted at a time: 16 words of 32 bits, one AVX-512 register. Taichi's CPU threads take a parallel
-# loop in blocks of at least 512 iterations (render/physics/runtime.py), so the loop is over runs of groups, not
-# rows: 720p is 360 rows of 20 runs.
+# Groups converted at a time: 16 words of 32 bits, one AVX-512 register (two AVX2 ones). Taichi's CPU threads
+# take a parallel loop in blocks of at least 512 iterations (render/physics/runtime.py), so the loop is over
+# runs of groups, not rows: 720p is 360 rows of 20 runs.
 LANES = 16
 # On two CPUs or fewer the loop runs on the launching thread: the conversion is bound by memory, and the thread
 # pool's wake-up cost CPU time that x264 needs on the other core. rigid_chaos's second 10 s of 720p frames,
