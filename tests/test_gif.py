@@ -24,21 +24,27 @@ def scene_of(name, *sets):
 
 
 def render(scene, out, threads=1):
-    """Render `scene`, keeping what the GIF's pipe was given (every queued frame's shape) and the GIF frames the
-    pipeline handed the encoder (video frame index -> frame)."""
-    piped, small = [], {}
+    """Render `scene`, keeping what the GIF's pipe was given (every queued frame's shape; its end as ("end", the
+    index of the video frame being written then, or None in close())) and the GIF frames the pipeline handed the
+    encoder (video frame index -> frame)."""
+    piped, small, writing = [], {}, [None]
     real_init, real_write = encode._Target.__init__, encode.Encoder.write
 
     def init(self, *a, **kw):
         real_init(self, *a, **kw)
         if self.small is not None:
             put = self.queue.put
-            self.queue.put = lambda x, *b, **c: (piped.append(None if x is None else x.shape), put(x, *b, **c))
+            self.queue.put = lambda x, *b, **c: (piped.append(("end", writing[0]) if x is None else x.shape),
+                                                 put(x, *b, **c))
 
     def write(self, frame, gif_frame=None):
         if gif_frame is not None:
             small[self.written] = gif_frame.copy()
-        return real_write(self, frame, gif_frame)
+        writing[0] = self.written
+        try:
+            return real_write(self, frame, gif_frame)
+        finally:
+            writing[0] = None
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(encode._Target, "__init__", init)
@@ -114,10 +120,12 @@ def test_the_gif_frames_are_the_gif_canvas_frames(rigid):
         assert psnr(frames[k], small[f]) >= 24.0, (k, psnr(frames[k], small[f]))
     # ... and they are not the video's frame shrunk: the text and the rods are drawn for this size
     assert all(s.shape == (h, w, 3) for s in small.values())
-    # the pipe: only frames of the GIF's size, every palette_step-th GIF frame (for the palette), then the end
+    # the pipe: only frames of the GIF's size, every palette_step-th GIF frame (for the palette), then the end,
+    # with the frame that brought the last of those (palettegen makes the palette while the rest are drawn)
     step = palette.palette_step(scene.video)
-    assert step > 1 and piped[-1] is None and set(piped[:-1]) == {(h, w, 3)}
-    assert len(piped) - 1 == len(shown[::step])
+    assert step > 1 and set(piped[:-1]) == {(h, w, 3)}
+    assert len(piped) - 1 == len(shown[::step]) and piped[-1] == ("end", shown[::step][-1])
+    assert shown[::step][-1] < scene.frames - 1  # so before the last frame, here
 
 
 @pytest.mark.parametrize("name", ["rigid_chaos", "rainbow_1000"])  # max compositing, and glow's hairlines

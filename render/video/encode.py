@@ -72,6 +72,8 @@ class _Target:
         self.small = small  # the GIF's (width, height): it is fed frames of that size only
         self.kept: list | None = None  # a GIF's frames, mapped to its palette at the end (Encoder._gif)
         self.step, self.rate = 1, None  # then every step-th is fed, for the palette; the GIF's frames a second
+        self.last_counted = -1  # the index of the last of those
+        self.ended = False  # its end (None) queued: no more frames for this ffmpeg
         self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
         self.error: BaseException | None = None
         try:
@@ -86,6 +88,10 @@ class _Target:
         while True:
             frame = self.queue.get()
             if frame is None:
+                try:
+                    self.proc.stdin.close()  # EOF: ffmpeg flushes (a GIF's palette needs every frame it counts)
+                except OSError:
+                    pass
                 return
             if self.error is not None:
                 continue  # keep draining so the producer never blocks on a dead encoder
@@ -140,6 +146,7 @@ class Encoder:
                             gif.size(video) if fmt == "gif" else None, planar)
                 if own:
                     t.kept, t.step, t.rate = [], palette.palette_step(video), rate
+                    t.last_counted = (sum(t.repeats) - 1) // t.step * t.step
                 self.targets.append(t)
         except BaseException:
             self.abort()
@@ -179,6 +186,9 @@ class Encoder:
                     continue
                 if len(t.kept) % t.step == 0:  # the frames palettegen counts
                     t.queue.put(mine)
+                    if len(t.kept) == t.last_counted:  # its last: EOF now, and the palette is made (0.38 s
+                        t.queue.put(None)  # for rigid_chaos) while the video's last frames are drawn
+                        t.ended = True
                 t.kept.append(mine)  # mapped to the palette at close()
         self.written += 1
         for s in self.stills:
@@ -188,13 +198,10 @@ class Encoder:
         """Finish encoding and rename into place; returns file name -> bytes. `audio`, (rate, int16 samples
         (S, 2)), is muxed into the MP4 (see _mux)."""
         for t in self.targets:
-            t.queue.put(None)
+            if not t.ended:
+                t.queue.put(None)
         for t in self.targets:
-            t.thread.join()
-            try:
-                t.proc.stdin.close()  # EOF: ffmpeg flushes (a GIF's palette needs every frame first)
-            except OSError:
-                pass
+            t.thread.join()  # and its pipe closed: EOF
         # The MP4's ffmpeg ends first (x264 has a few frames left; a GIF's palette needs every frame): its track
         # is muxed on a thread of its own (a second ffmpeg: 0.54 s for rigid_chaos) while the GIF is mapped here.
         muxed = []  # what the muxing thread raised, if anything
