@@ -202,8 +202,9 @@ class Encoder:
                 t.queue.put(None)
         for t in self.targets:
             t.thread.join()  # and its pipe closed: EOF
-        # The MP4's ffmpeg ends first (x264 has a few frames left; a GIF's palette needs every frame): its track
-        # is muxed on a thread of its own (a second ffmpeg: 0.54 s for rigid_chaos) while the GIF is mapped here.
+        # The MP4's ffmpeg ends first (x264 has a few frames left; palettegen had its EOF with the last frame it
+        # counts, write()): its track is muxed on a thread of its own (a second ffmpeg: 0.54 s for rigid_chaos)
+        # while the GIF is mapped here.
         muxed = []  # what the muxing thread raised, if anything
         muxing = None
         try:
