@@ -43,8 +43,10 @@ def x264_threads() -> list[str]:
     2-core Xeon with AVX-512, 2026-12-06). In a render the other core simulates and draws, so what counts on two
     cores is the CPU time, not x264's own wall time: one thread took the whole render from 24.2-24.8 s to
     22.5-22.8 s (alternating, two each), and after this round's cheaper drawing 24.5 s to 22.7 s (3
-    interleaved rounds). Where x264 is the render's slowest part, a fan light to draw, its own threads would be
-    quicker: one thread pays off while the rest of the render costs at least about 4/5 of x264's CPU time."""
+    interleaved rounds). Since the drawing got cheaper still, one thread no longer clearly pays: renders within
+    3 % of two threads' (and of x264's own count), with x264 alone on two threads 4 % above one in CPU (late
+    2026-12-06, docs/performance.md). It is kept for that CPU, which renders running side by side share
+    (`batch`); where x264 is all a render waits for, a fan light to draw, its own threads would be quicker."""
     # config/options.py's usable_cores(), which sits a layer above this one (docs/architecture.md)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
     return ["-threads", "1"] if cpus <= ONE_THREAD_CPUS else []
