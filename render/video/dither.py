@@ -33,7 +33,7 @@ def _map(frames: ti.types.ndarray(dtype=ti.u8, ndim=4), out: ti.types.ndarray(dt
          black: ti.types.ndarray(dtype=ti.i32, ndim=1), starts: ti.types.ndarray(dtype=ti.i32, ndim=1),
          listed: ti.types.ndarray(dtype=ti.i32, ndim=1)):
     # rows in parallel, each walked along x: one loop over (f, y, x), its flat index divided back into three at
-    # every pixel, took 0.22-0.31 s for rigid_chaos's 400 frames all black against 0.06 s (benchmarks/gif_map.py)
+    # every pixel, took 0.22-0.31 s for rigid_chaos's 400 frames all black, this 0.06-0.10 s (benchmarks/gif_map.py)
     for f, y in ti.ndrange(out.shape[0], out.shape[1]):
         for x in range(out.shape[2]):
             at = (y & 7) * 8 + (x & 7)
