@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 export TI_SKIP_VERSION_CHECK := ON
 
-.PHONY: demo test goldens presets accuracy bench batch figures clean
+.PHONY: demo test goldens check-avx2 presets accuracy bench batch figures clean
 
 $(BIN)/pendulum: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,11 @@ test: $(BIN)/pendulum
 # After a deliberate visual change: rewrite tests/golden/ from the current renderer, then review and commit.
 goldens: $(BIN)/pendulum
 	$(BIN)/python -m pytest tests/test_golden.py tests/test_font.py --update-goldens -q
+
+# The golden frames and tests/test_sincos.py on an AVX2 CPU emulated by QEMU (apt-get install -y qemu-user), for
+# a machine with AVX-512: slow, and not part of `make test` (docs/testing.md).
+check-avx2: $(BIN)/pendulum
+	$(BIN)/python tests/emulated_cpu.py --sincos
 
 presets: $(BIN)/pendulum
 	$(BIN)/pendulum presets
