@@ -18,6 +18,7 @@ status 0 when every preset matches (and test_sincos.py passes), 1 otherwise, 2 w
 import argparse
 import os
 import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -85,10 +86,15 @@ def main(argv=None) -> int:
         print(f"emulated_cpu: needs {QEMU} on an x86-64 Linux (Debian: apt-get install -y qemu-user)",
               file=sys.stderr)
         return 2
-    names = args.presets or sorted(p.stem for p in (ROOT / "presets").glob("*.toml"))
-    missing = [n for n in names if not (ROOT / "tests" / "golden" / n).is_dir()]
-    if missing:
-        print(f"emulated_cpu: no golden frames for {', '.join(missing)} in tests/golden/", file=sys.stderr)
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", args.cpu):  # it names a folder under out/
+        print(f"emulated_cpu: --cpu {args.cpu!r} is not a CPU model's name (`{QEMU} -cpu help`)", file=sys.stderr)
+        return 2
+    shipped = sorted(p.stem for p in (ROOT / "presets").glob("*.toml"))
+    names = args.presets or shipped
+    unknown = [n for n in names if n not in shipped or not (ROOT / "tests" / "golden" / n).is_dir()]
+    if unknown:
+        print(f"emulated_cpu: {', '.join(unknown)}: not a preset of presets/ with golden frames in tests/golden/",
+              file=sys.stderr)
         return 2
     work = ROOT / "out" / f"emulated-{args.cpu}"
     shutil.rmtree(work, ignore_errors=True)
