@@ -9,7 +9,7 @@ and libm take its code paths. Each preset (default: all of presets/) is rendered
 renders it (tests/conftest.py's render_small), in an emulated process of its own, and its frames are held here
 to tests/golden/ by test_golden's rule (ATOL, MAX_BAD_FRACTION). --sincos runs tests/test_sincos.py emulated
 too. Not part of `make test`: emulation is slow. On the 2-core Xeon (2026-12-06): 45 s to 3.5 min a preset,
-but fractal_lyapunov (7.6 s of CPU natively) far longer, and 2-3 min for test_sincos.py.
+but fractal_lyapunov (7.6 s of CPU natively) 50 min on both cores; 2-3 min for test_sincos.py.
 
 Everything it writes is under out/emulated-CPU/ (renders, frames, a Taichi kernel cache of its own, so that
 kernels compiled for this machine's CPU are never loaded there), removed at the end unless --keep. Exit
