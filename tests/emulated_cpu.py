@@ -13,7 +13,8 @@ but fractal_lyapunov (7.6 s of CPU natively) 50 min on both cores; 2-3 min for t
 
 Everything it writes is under out/emulated-CPU/ (renders, frames, a Taichi kernel cache of its own, so that
 kernels compiled for this machine's CPU are never loaded there), removed at the end unless --keep. Exit
-status 0 when every preset matches (and test_sincos.py passes), 1 otherwise, 2 without qemu-x86_64.
+status 0 when every preset matches (and test_sincos.py passes), 1 otherwise, 2 (one line, nothing written)
+without qemu-x86_64 or for a --cpu or preset it does not know.
 """
 import argparse
 import os
@@ -120,7 +121,7 @@ def main(argv=None) -> int:
                 failed += 1
                 continue
             ok, line = compare(name, npz)
-            seen = res.stdout.strip().splitlines()[-1]
+            seen = (res.stdout.strip().splitlines() or ["features not reported"])[-1]
             print(f"{name}: {'matches' if ok else 'DIFFERS FROM'} its golden frames on {args.cpu} ({seen}); {line}",
                   flush=True)
             failed += not ok
