@@ -26,6 +26,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # render/, and conftest and test_golden, in either process
 QEMU = "qemu-x86_64"
 
 
@@ -46,7 +47,6 @@ def child(preset: str, npz: Path, out: Path) -> int:
         return argsort(a, *args, **kwargs)
 
     np.argsort = distinct_stable
-    sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
     import conftest
     from render.draw import split
     split.cost = conftest.fixed_cost  # as the preset_renders fixture does
@@ -60,7 +60,6 @@ def compare(preset: str, npz: Path) -> tuple[bool, str]:
     """(matches, a line) for the emulated frames against tests/golden/PRESET/, by test_golden's rule."""
     import imageio.v3 as iio
     import numpy as np
-    sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
     import test_golden
 
     worst, ok, frames = 0, True, np.load(npz)
