@@ -2,7 +2,7 @@
 time and in this thread's CPU time, so that waiting (on x264's pipe, or for a core x264 holds) shows apart
 from work.
 
-    .venv/bin/python benchmarks/render_threads.py [PRESET] [--warm] [--set KEY=VALUE]...
+    .venv/bin/python benchmarks/render_threads.py [PRESET] [--warm] [--x264-preset P] [--set KEY=VALUE]...
 
 Renders PRESET (default rigid_chaos) into a temporary folder as `pendulum render` does, with a timer around
 Source.next_frame (simulate and draw the video's frame, its HUD included), gif.Frames.frame (the GIF's own
@@ -15,7 +15,8 @@ Then the render's timeline, in seconds from its start: when the first frame reac
 last one had been handed over, when each ffmpeg process exited (x264's first, then the GIF's palettegen;
 the GIF's writer and the audio's mux come after) and when the render returned. --warm renders one frame
 first, in the same process, as `pendulum bench` does before its timed render (Taichi started, its kernels
-loaded).
+loaded). --x264-preset renders with another of x264's presets than render/video/mp4.py's PRESET (the same
+crf), to see what the encoder's speed does to the whole render.
 """
 import argparse
 import collections
@@ -29,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from render.config.scene import load  # noqa: E402
 from render.draw.hud import Hud  # noqa: E402
-from render.video import encode, gif, pipeline, yuv  # noqa: E402
+from render.video import encode, gif, mp4, pipeline, yuv  # noqa: E402
 
 STAGES = [(pipeline.Source, "next_frame", "video frame (simulate + draw + HUD)"),
           (gif.Frames, "frame", "GIF frame"),
@@ -79,8 +80,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("preset", nargs="?", default="rigid_chaos")
     ap.add_argument("--warm", action="store_true", help="render one frame first, as pendulum bench does")
+    ap.add_argument("--x264-preset", choices=["ultrafast", "superfast", "veryfast", "faster", "fast", "medium"],
+                    help=f"x264's preset for the MP4 (default: the render's, {mp4.PRESET})")
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(argv)
+    mp4.PRESET = args.x264_preset or mp4.PRESET
     scene = load(args.preset, args.overrides)
     with tempfile.TemporaryDirectory(prefix="render-threads-") as tmp:
         if args.warm:
@@ -93,7 +97,7 @@ def main(argv=None) -> int:
         meta = pipeline.render(scene, Path(tmp))
         marks["render returned"] = end = time.perf_counter()
         wall, cpu = end - wall, time.process_time() - cpu
-    print(f"{args.preset}: pipeline.render {wall:.2f} s wall, {cpu:.2f} s CPU of this process (all its threads)")
+    print(f"{args.preset} (x264 {mp4.PRESET}): pipeline.render {wall:.2f} s wall, {cpu:.2f} s CPU of this process (all its threads)")
     print(f"timings_s: {meta['timings_s']}")
     print("| stage | calls | wall s | main thread CPU s | wall ms a call |\n|---|---:|---:|---:|---:|")
     for _, _, label in STAGES:

@@ -10,6 +10,15 @@ Chosen on rigid_chaos (20 s, 1280x720, 60 fps), every setting encoding the same 
   pendulums' circle, where the HUD and a map's axes live (render/draw/hud.py), get a finer quantiser (x264's
   regions of interest, ffmpeg's addroi, qoffset ROI_QOFFSET) and the rest crf 32. On the first 8 s: the same
   bytes (1.31 vs 1.30 MB), the HUD's corners 38.8 dB instead of 33.3, the whole frame 30.18 dB instead of 30.22.
+- "superfast" instead of "veryfast" (2026-12-06, 2-core Xeon with AVX-512): on two cores a render is bound by
+  the CPU that x264 and the drawing share, and x264 took half of it. rigid_chaos's 1200 frames, one thread,
+  these arguments (`python benchmarks/x264_presets.py --x264 veryfast:32 superfast:32 superfast:33
+  superfast:34 ultrafast:32`, 2 interleaved rounds): veryfast 11.68-11.73 s of CPU, 10.95 MB, 30.23 dB (ffmpeg's
+  psnr, the planes' mean); superfast at crf 32 7.45-7.53 s, 12.03 MB, 30.09 dB; at crf 33 10.62 MB, 29.50 dB;
+  ultrafast 3.2-3.3 s but 21.82 MB. So a third less of x264's CPU for a tenth more bytes and 0.14 dB; at equal
+  bytes superfast would cost 0.7 dB, so the crf stays. fractal_flip's map: 4.74 → 3.92 s, 0.54 → 0.70 MB,
+  37.68 → 37.78 dB. Whole renders of rigid_chaos 14.67-14.91 s → 12.04-12.30 s (`python
+  benchmarks/render_threads.py --warm --x264-preset P`, 3 rounds alternating); the MP4 11.29 → 12.37 MB.
 """
 import os
 import subprocess
@@ -19,7 +28,7 @@ import numpy as np
 
 from .atomic import temp_beside
 
-PRESET, CRF, ROI_QOFFSET = "veryfast", "32", -0.3
+PRESET, CRF, ROI_QOFFSET = "superfast", "32", -0.3
 ONE_THREAD_CPUS = 2  # see x264_threads()
 REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
