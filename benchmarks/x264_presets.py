@@ -25,8 +25,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import imageio_ffmpeg  # noqa: E402
 
-from render.config.scene import load  # noqa: E402
-from render.video import mp4 as mp4_settings, pipeline, yuv  # noqa: E402
+from render.video import mp4 as mp4_settings, yuv  # noqa: E402
+from yuv_pipe import planar_source  # noqa: E402  (this script's folder is on the path)
 
 SETTING = re.compile(r"(ultrafast|superfast|veryfast|faster|fast|medium):(\d{1,2})")
 
@@ -77,11 +77,10 @@ def main(argv=None) -> int:
         print(f"--x264 takes PRESET:CRF, e.g. superfast:33 (not {' '.join(bad)}); --rounds at least 1",
               file=sys.stderr)
         return 2
-    src = pipeline.Source(load(args.preset, args.overrides))
-    v = src.scene.video
-    if not yuv.fits(v.width, v.height):
-        print(f"{v.width}x{v.height}: yuv.convert needs a width divisible by 4 and an even height", file=sys.stderr)
+    src = planar_source(args.preset, args.overrides)
+    if src is None:
         return 2
+    v = src.scene.video
     args.out.mkdir(parents=True, exist_ok=True)
     raw = args.out / "frames.yuv"
     mp4s = {m[0]: args.out / f"{m[1]}_{m[2]}.mp4" for m in settings}

@@ -37,6 +37,17 @@ def encode_file(raw: Path, pix_fmt: str, video, mp4: Path) -> tuple[float, float
     return time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - before
 
 
+def planar_source(preset: str, overrides: list[str]):
+    """The preset's frames as `pendulum render` draws them (pipeline.Source), or None, with one line on stderr,
+    where yuv.convert cannot take frames of its size. benchmarks/x264_presets.py draws its frames here too."""
+    src = pipeline.Source(load(preset, overrides))
+    v = src.scene.video
+    if not yuv.fits(v.width, v.height):
+        print(f"{v.width}x{v.height}: yuv.convert needs a width divisible by 4 and an even height", file=sys.stderr)
+        return None
+    return src
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("preset", nargs="?", default="rigid_chaos")
@@ -44,11 +55,10 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=Path("out/yuv_pipe"))
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(argv)
-    src = pipeline.Source(load(args.preset, args.overrides))
-    v = src.scene.video
-    if not yuv.fits(v.width, v.height):
-        print(f"{v.width}x{v.height}: yuv.convert needs a width divisible by 4 and an even height", file=sys.stderr)
+    src = planar_source(args.preset, args.overrides)
+    if src is None:
         return 2
+    v = src.scene.video
     args.out.mkdir(parents=True, exist_ok=True)
     raw = {"rgb24": args.out / "frames.rgb", "yuv420p": args.out / "frames.yuv"}
     ms = []
