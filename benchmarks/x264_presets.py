@@ -38,14 +38,14 @@ def x264_args(video, preset: str, crf: str) -> list[str]:
     return args
 
 
-def raw_input(raw: Path, video) -> list[str]:
+def raw_args(raw: Path, video) -> list[str]:
     return ["-f", "rawvideo", "-pix_fmt", "yuv420p", "-s", f"{video.width}x{video.height}", "-r", str(video.fps),
             "-i", str(raw)]
 
 
 def encode(raw: Path, video, preset: str, crf: str, mp4: Path) -> tuple[float, float]:
     """(wall s, ffmpeg's user CPU s) for one MP4 from the raw file."""
-    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", *raw_input(raw, video),
+    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", *raw_args(raw, video),
            "-an", *x264_args(video, preset, crf), str(mp4)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
     t = time.perf_counter()
@@ -55,7 +55,7 @@ def encode(raw: Path, video, preset: str, crf: str, mp4: Path) -> tuple[float, f
 
 def psnr(raw: Path, video, mp4: Path) -> tuple[float, float]:
     """(mean PSNR over the planes, Y's) of the decoded MP4 against the raw frames, dB."""
-    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", *raw_input(raw, video), "-i", str(mp4),
+    cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", *raw_args(raw, video), "-i", str(mp4),
            "-lavfi", "[1:v][0:v]psnr", "-f", "null", "-"]
     log = subprocess.run(cmd, check=True, capture_output=True, text=True).stderr
     line = [s for s in log.splitlines() if "PSNR y:" in s][-1]

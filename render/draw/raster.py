@@ -134,7 +134,7 @@ class Raster:
             # / |d|, linear in v: no division and no square root a pixel. rigid_chaos at 720p, draw_frame with
             # rods alone 1.93 → 1.64 ms a frame (`python benchmarks/draw_kernels.py rigid_chaos --set
             # 'effects=["rods"]'`, 2 rounds each); its rounding differs from the projection's by one level in
-            # 1e-7 of the channels (its first 4 s). Columns at the end caps, and pieces under a pixel long (a
+            # a few pixels a video (the goldens hold). Columns at the end caps, and pieces under a pixel long (a
             # trail's), take the projection.
             qx = ti.cast(u, ti.f32) - a[0]
             tlo = (qx * d[0] + (ti.cast(lo, ti.f32) - a[1]) * d[1]) / ll
@@ -166,19 +166,20 @@ class Raster:
         # conversion a pixel: the same bytes. rigid_chaos at 720p, draw_frame with bobs alone 0.83 → 0.52 ms a
         # frame, with rods and trails too 3.32-3.44 → 3.06-3.10 ms (`python benchmarks/draw_kernels.py
         # rigid_chaos [--set 'effects=["bobs"]']`, 2026-12-06).
-        ri = ti.max(r - 0.51, 0.0) * ti.max(r - 0.51, 0.0)
+        core = ti.max(r - 0.51, 0.0)
+        core *= core  # the squared radius of that core
         full = ti.Vector([ti.cast(to_byte(ti.cast(c[k], ti.f32)), ti.i32) for k in ti.static(range(3))])
         for y in range(ti.max(cy - reach, y0), ti.min(cy + reach, y1 - 1) + 1):
             dy = ti.cast(y, ti.f32) - centre[1]
             if dy * dy < rr:  # only the columns a row of the disc covers (with a hair of margin)
                 half = ti.sqrt(rr - dy * dy) + 0.01
-                inner = ti.sqrt(ti.max(ri - dy * dy, 0.0))
-                xi0, xi1 = int(ti.ceil(centre[0] - inner)), int(ti.floor(centre[0] + inner))
-                if dy * dy >= ri:
+                half_core = ti.sqrt(ti.max(core - dy * dy, 0.0))
+                xi0, xi1 = int(ti.ceil(centre[0] - half_core)), int(ti.floor(centre[0] + half_core))
+                if dy * dy >= core:  # the row misses the core
                     xi0, xi1 = 1, 0
                 for x in range(ti.max(cx - reach, int(ti.ceil(centre[0] - half))),
                                ti.min(cx + reach, int(ti.floor(centre[0] + half))) + 1):
-                    if ti.static(self.banded and not self.glowing and self.rgb.dtype == ti.u8):
+                    if ti.static(self.rgb.dtype == ti.u8):  # a layer of bytes (canvas.BYTE_LAYER)
                         if xi0 <= x <= xi1:
                             self.plot_bytes(y, x, full, y0, y1)
                         else:
