@@ -1,6 +1,6 @@
-"""render/video/encode.py, gif.py and palette.py: the GIF's frames are picked before the pipe, exactly as ffmpeg's fps
-filter picked them, and shrunk before it, exactly as an area average does; its palette is palettegen's, and its
-pixels are mapped to it as written here."""
+"""render/video/encode.py, gif.py, downscale.py and palette.py: the GIF's frames are picked before the pipe,
+exactly as ffmpeg's fps filter picked them, and shrunk before it, by their exact area average; its palette is
+palettegen's, and its pixels are mapped to it as written here."""
 import itertools
 import math
 import subprocess
@@ -10,7 +10,7 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 
-from render.video import encode, gif, palette
+from render.video import downscale, encode, gif, palette
 
 EXE = imageio_ffmpeg.get_ffmpeg_exe()
 
@@ -62,7 +62,7 @@ def test_the_gif_is_byte_identical_to_one_of_the_frames_the_fps_filter_picks(tmp
     picks = fps_filter_picks(60, 20, n)
     enc = encode.Encoder(tmp_path, "filtered", video(20, 20, 48, 28, 48), len(picks), formats=["gif"])
     for i in picks:
-        enc.write(gif.shrink(frames[i], 48, 28))
+        enc.write(downscale.shrink(frames[i], 48, 28))
     enc.close()
     assert (tmp_path / "picked.gif").read_bytes() == (tmp_path / "filtered.gif").read_bytes()
     assert piped == len(picks) == 16 == len(list(itertools.islice(frames, 0, n, 3)))
@@ -115,35 +115,20 @@ def test_the_gif_palette_is_palettegens_of_sampled_cut_frames_and_each_pixel_its
     np.testing.assert_array_equal(decoded(tmp_path / "cut.gif").reshape(n, 28, 48, 3), np.stack(want))
 
 
-def area_reference(frame: np.ndarray, w: int, h: int) -> np.ndarray:
-    """An area average written independently: each output pixel integrates the frame, upsampled by the least
-    common multiple of the sizes (so every output pixel covers whole sub-pixels), over its rectangle."""
-    H, W = frame.shape[:2]
-    ly, lx = math.lcm(H, h), math.lcm(W, w)
-    up = frame.astype(np.float64).repeat(ly // H, 0).repeat(lx // W, 1)
-    return up.reshape(h, ly // h, w, lx // w, 3).mean(axis=(1, 3))
-
-
-@pytest.mark.parametrize("size", [(96, 54, 48, 28), (128, 72, 35, 20), (64, 36, 64, 36), (50, 30, 7, 4)])
-def test_shrink_is_an_area_average(size):
+@pytest.mark.parametrize("size", [(96, 54, 48, 28), (128, 72, 35, 20), (64, 36, 64, 36), (50, 30, 7, 4),
+                                  (1280, 720, 352, 198), (101, 37, 100, 36), (30, 20, 29, 19)])
+def test_shrink_is_the_exact_area_mean_rounded_half_up(size):
+    """Every byte is the area mean of what it covers, exactly, rounded to nearest with a half up: the frame
+    upsampled by the least common multiple of the sizes, whole blocks summed in integers, and divided."""
     W, H, w, h = size
-    frame = np.random.default_rng(7).integers(0, 256, (H, W, 3), dtype=np.uint8)
-    got = gif.shrink(frame, w, h)
-    assert got.shape == (h, w, 3) and got.dtype == np.uint8
-    assert np.abs(got.astype(np.float64) - area_reference(frame, w, h)).max() <= 0.5 + 1e-9  # rounding only
-    flat = np.full((H, W, 3), 200, np.uint8)
-    assert (gif.shrink(flat, w, h) == 200).all()  # a flat frame stays flat: the weights sum to one
-
-
-@pytest.mark.parametrize("n, m", [(720, 198), (144, 99), (1080, 198), (500, 499), (300, 7), (64, 64)])
-def test_the_rows_are_summed_cell_by_cell_as_reduceat_sums_them(n, m):
-    """shrink's first pass sums each cell of rows in whole-row passes, not with reduceat: the same integers,
-    the last cell running to the end where k[m] rounds down (500 rows into 499: 499.99999 -> 499)."""
-    frame = np.random.default_rng(n + m).integers(0, 256, (n, 40, 3), dtype=np.uint8)
-    k = np.floor(np.arange(m + 1) * (n / m)).astype(np.int64)
-    want = np.add.reduceat(frame, k[:-1], axis=0, dtype=np.int64)
-    got = gif._cell_sums(frame, k)
-    assert got.shape == want.shape and (got == want).all()
+    frame = np.random.default_rng(W + h).integers(0, 256, (H, W, 3), dtype=np.uint8)
+    ly, lx = math.lcm(H, h), math.lcm(W, w)
+    up = frame.astype(np.int64).repeat(ly // H, 0).repeat(lx // W, 1)
+    total, count = up.reshape(h, ly // h, w, lx // w, 3).sum(axis=(1, 3)), (ly // h) * (lx // w)
+    assert (downscale.shrink(frame, w, h) == (2 * total + count) // (2 * count)).all()
+    assert (downscale.shrink(np.full((H, W, 3), 200, np.uint8), w, h) == 200).all()  # the shares sum to one
+    tie = np.array([[[0, 3, 250], [1, 4, 251]]], np.uint8)  # means 0.5, 3.5 and 250.5: a half goes up
+    assert downscale.shrink(tie, 1, 1).tolist() == [[[1, 4, 251]]]
 
 
 def test_a_gif_frame_of_the_wrong_size_is_refused(tmp_path):

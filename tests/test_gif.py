@@ -10,7 +10,7 @@ import pytest
 
 from conftest import ocr_line
 from render.config.scene import load
-from render.video import encode, gif, palette, pipeline
+from render.video import downscale, encode, gif, palette, pipeline
 
 # A frame larger than the GIF's and a rate higher than its own, so the GIF has a canvas of its own; short, since
 # every render compiles its kernels.
@@ -174,7 +174,7 @@ def test_the_gif_is_drawn_not_shrunk(rigid, tmp_path):
     first = min(small)
     big = iio.imread(mp4, index=first)  # decoded: close enough to the raw frame for its text's contrast
     w, h = gif.size(scene.video)
-    shrunk = gif.shrink(big, w, h)[:17, :90].max(axis=2)
+    shrunk = downscale.shrink(big, w, h)[:17, :90].max(axis=2)
     drawn = small[first][:17, :90].max(axis=2)
     assert (drawn >= 230).sum() > 3 * max((shrunk >= 230).sum(), 1)
 

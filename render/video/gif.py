@@ -10,8 +10,8 @@ canvas keeps where the last bob was at each (Canvas.follow) and stamps them with
 
 A comparison's GIF is a second split screen at the GIF's size drawn from the first one's recorded runs.
 A map's pixels are its pendulums, so a second map would be a second simulation: a map's GIF frame is the
-video's frame area-averaged in numpy (shrink). So is a frame with a Poincaré section (its crossings are read
-once per video frame) and any frame a caller hands the Encoder without a GIF frame of its own.
+video's frame area-averaged (render/video/downscale.py). So is a frame with a Poincaré section (its crossings
+are read once per video frame) and any frame a caller hands the Encoder without a GIF frame of its own.
 
 Which video frames the GIF keeps is ffmpeg's fps filter's choice, made here (repeats) so the pipe carries only
 those.
@@ -24,6 +24,8 @@ import time
 from fractions import Fraction
 
 import numpy as np
+
+from .downscale import shrink
 
 
 def rate(video) -> int:
@@ -50,49 +52,6 @@ def repeats(video, frames: int) -> list[int]:
     slots = math.ceil(frames * r)
     starts = [_near(i * r) for i in range(frames)] + [slots]  # the last frame fills the slots up to the end
     return [max(0, min(starts[i + 1], slots) - starts[i]) for i in range(frames)]
-
-
-def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
-    """An H×W×3 uint8 frame area-averaged down to h×w: each pixel the mean of the area of the frame it covers,
-    partly covered pixels weighted by their share (what ffmpeg's flags=area does). numpy sums in order on
-    one thread, so the bytes never depend on the thread count. Rows first: that pass reads the whole frame,
-    and rows are contiguous."""
-    if frame.shape[:2] == (h, w):
-        return frame
-    rows = _average(frame, h)
-    return np.rint(np.swapaxes(_average(np.swapaxes(rows, 0, 1), w), 0, 1)).clip(0, 255).astype(np.uint8)
-
-
-def _average(a: np.ndarray, m: int) -> np.ndarray:
-    """a (n ≥ m cells along its first axis) averaged down to m: whole cells summed in integers (exact), the
-    cells an edge cuts shared by the fraction on each side."""
-    n = len(a)
-    edges = np.arange(m + 1) * (n / m)
-    k = np.floor(edges).astype(np.int64)  # strictly increasing, since n / m >= 1; k[m] = n (or n - 1: round-off)
-    frac = (edges - k).reshape(-1, *[1] * (a.ndim - 1))
-    cut = np.take(a, np.minimum(k, n - 1), axis=0) * frac  # frac[m] = 0: nothing past the end
-    return (_cell_sums(a, k) + cut[1:] - cut[:-1]) * (m / n)
-
-
-def _cell_sums(a: np.ndarray, k: np.ndarray) -> np.ndarray:
-    """The sums of a's cells a[k[i]:k[i + 1]], the last one to the end of a whatever k[m] rounded to, as
-    np.add.reduceat gives them. A frame's bytes are summed in whole-row passes, the j-th row of every cell at
-    once, exact in int32 (255 · rows): reduceat steps through each cell of each column on its own, and took
-    14 ms of the 17 ms in which a 720p frame was shrunk to 352 × 198 (this way: 8.7 ms in all). Floats (the
-    second pass, over columns) stay with reduceat, whose order of additions the bytes depend on, and which
-    is fast there."""
-    start = k[:-1]
-    if a.dtype.kind not in "ui":
-        return np.add.reduceat(a, start, axis=0)
-    lens = np.diff(np.append(start, len(a)))
-    whole = np.take(a, start, axis=0).astype(np.int32)
-    for j in range(1, int(lens.max())):
-        has = lens > j
-        if has.all():
-            whole += np.take(a, start + j, axis=0)
-        else:
-            whole[has] += a[start[has] + j]
-    return whole
 
 
 def gap(repeats: list[int]) -> int:
