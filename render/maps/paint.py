@@ -130,9 +130,7 @@ class Painting:
             elif ev == NEVER:
                 claim = 0.0  # settled by energy, not by the integration
             elif ti.static(self.twins):
-                a, b = 2 * j, 2 * j + 1
-                col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
-                                            + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
+                col = self.together(self.apart[j])  # the pair's distance, kept by the advance
             else:
                 col = ti.Vector([PENDING_GREY] * 3)
         if claim > self.until[p]:
