@@ -2,10 +2,10 @@
 (the colourings and the trust mask of render/maps/fractal.py), and the legend's swatches in the same colours.
 
 Painting is the map's half that draws: Map (fractal.py) and FtleMap (ftle.py) inherit it and set what it reads
-(the scene and layout, the event and faithful-time fields, the colour scales). An event map (flip_time,
-divergence) keeps its plot between frames: a pixel whose points have all settled, or cannot flip, keeps its
-colour, so only the pixels still pending, or settled since the last frame, are painted again; at the end of a
-20 s flip map, 7 % of them.
+(the scene and layout, the event and faithful-time fields, a divergence map's pair distances, the colour
+scales). An event map (flip_time, divergence) keeps its plot between frames: a pixel whose points have all
+settled, or cannot flip, keeps its colour, so only the pixels still pending, or settled since the last frame,
+are painted again; at the end of a 20 s flip map, 7 % of them.
 """
 
 import math

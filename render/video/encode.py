@@ -21,7 +21,7 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 
-from . import downscale, gif, mp4, palette
+from . import gif, mp4, palette
 from .atomic import publish, temp_beside
 from ..errors import EncodeError
 
@@ -177,7 +177,10 @@ class Encoder:
         for t in self.targets:
             n = 1 if t.repeats is None else t.repeats[self.written]
             if n and t.small is not None:
-                mine = downscale.shrink(frame, *t.small) if small is None else small
+                mine = small
+                if small is None:
+                    from .downscale import shrink  # Taichi: not for a plan (render/config/budget.py reads this module)
+                    mine = shrink(frame, *t.small)
                 if mine.shape != (t.small[1], t.small[0], 3):
                     raise ValueError(f"a GIF frame of {mine.shape[1]}x{mine.shape[0]}, not {t.small[0]}x{t.small[1]}")
             for _ in range(n):

@@ -25,8 +25,6 @@ from fractions import Fraction
 
 import numpy as np
 
-from .downscale import shrink
-
 
 def rate(video) -> int:
     return min(video.gif_fps, video.fps)
@@ -153,7 +151,9 @@ class Frames:
         t = time.perf_counter()
         out = None
         if self.own is None:
-            out = shrink(video_frame, self.w, self.h) if self.repeats[f] else None
+            if self.repeats[f]:
+                from .downscale import shrink  # Taichi: not for a plan (it imports this module)
+                out = shrink(video_frame, self.w, self.h)
         elif self.repeats[f]:
             out = self.own.draw(f)
         else:
