@@ -20,7 +20,7 @@ import numpy as np
 import taichi as ti
 
 from ..physics import runtime
-from .yuv import SERIAL_THREADS
+from .yuv import serial
 
 LANES = 16  # words of a row summed at a time: one AVX-512 register of 32-bit lanes (two AVX2 ones)
 
@@ -101,12 +101,11 @@ def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
     if span % 4:
         words = np.concatenate([words, np.zeros((H, -span % 4), np.uint8)], axis=1)
     stride = words.shape[1]
-    cfg = ti.lang.impl.current_cfg()
-    # On two CPUs or fewer, on the launching thread, as yuv.convert: the encoders hold the other core, and the
+    # On two CPUs or fewer on the launching thread, as yuv.convert: the encoders hold the other core, and the
     # thread pool's wake-up cost more CPU than it saved (2.5 ms wall and 3.6 ms CPU a frame on two threads)
-    serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_THREADS
+    one = serial()
     rows = np.empty(h * stride, np.int32)
-    _rows(words.reshape(-1).view(np.uint32), rows, fy, sy, H, stride // 4, serial)
+    _rows(words.reshape(-1).view(np.uint32), rows, fy, sy, H, stride // 4, one)
     out = np.empty((h, w, 3), np.uint8)
-    _columns(rows, out.reshape(-1), fx, sx, W, stride, h, float(H * W), serial)
+    _columns(rows, out.reshape(-1), fx, sx, W, stride, h, float(H * W), one)
     return out

@@ -58,6 +58,13 @@ LANES = 16
 SERIAL_THREADS = 2
 
 
+def serial() -> bool:
+    """Whether a frame's conversion runs on the launching thread (SERIAL_THREADS); on CUDA a loop is never
+    serialised (that would be one GPU thread)."""
+    cfg = ti.lang.impl.current_cfg()
+    return cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_THREADS
+
+
 @ti.kernel
 def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(dtype=ti.u32, ndim=1),
              cb2: ti.types.ndarray(dtype=ti.u16, ndim=1), cr2: ti.types.ndarray(dtype=ti.u16, ndim=1), w: ti.i32,
@@ -121,7 +128,6 @@ def convert(frame: np.ndarray) -> np.ndarray:
     out = np.empty(size(w, h), np.uint8)
     n, c = w * h, w * h // 4
     words = np.ascontiguousarray(frame).reshape(-1).view(np.uint32)
-    cfg = ti.lang.impl.current_cfg()
-    serial = cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_THREADS  # (on CUDA: one GPU thread)
-    _convert(words, out[:n].view(np.uint32), out[n:n + c].view(np.uint16), out[n + c:].view(np.uint16), w, serial)
+    _convert(words, out[:n].view(np.uint32), out[n:n + c].view(np.uint16), out[n + c:].view(np.uint16), w,
+             serial())
     return out
