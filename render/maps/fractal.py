@@ -80,6 +80,11 @@ class Map(Painting, runtime.Launcher):
         self.cannot = runtime.field("fractal.cannot_flip", ti.u8, self.points)  # E < B, whatever the colouring
         self.pending = runtime.field("fractal.pending", ti.i32, self.points)  # the points with an event ahead
         self.n_pending = runtime.field("fractal.n_pending", ti.i32, ())
+        # divergence: each pair's distance where the advance left it, for the paint's grey. Both states read again
+        # there were 64 bytes a pixel, which beside x264 cost: fractal_divergence's renders drew in 11.1 and 10.4 s
+        # that way, 6.8 and 6.7 s this way (alternating); alone, in benchmarks/map_frame.py, no difference showed
+        # (6.1-6.6 ms a frame either way)
+        self.apart = runtime.field("fractal.apart", runtime.real(), self.points if self.twins else 1)
         self.until = self.faithful(cert)
         self.font = Font(self.lay.font) if self.lay.font else None
         self.background = self.decorate()
@@ -176,6 +181,9 @@ class Map(Painting, runtime.Launcher):
             below = self.sim.energy(self.sim.q[i], self.sim.v[i]) < self.barrier
             self.cannot[j] = ti.cast(below, ti.u8)
             self.event[j] = PENDING
+            if ti.static(self.twins):
+                self.apart[j] = ti.sqrt((self.sim.q[i] - self.sim.q[i + 1]).norm_sqr()
+                                        + (self.sim.v[i] - self.sim.v[i + 1]).norm_sqr())
             if ti.static(self.kind == "flip_time"):
                 if below:
                     self.event[j] = NEVER
@@ -258,6 +266,8 @@ class Map(Painting, runtime.Launcher):
                             i = j * L + m
                             sim.q[i], sim.v[i] = Q[:, k * L + m], V[:, k * L + m]
                             sim.watch(i, Q[:, k * L + m], V[:, k * L + m])
+                        if ti.static(self.twins):
+                            self.apart[j] = near[k]
 
     @ti.func
     def events(self, j, q, q1, lane, d0, d1, t, h):

@@ -2,10 +2,10 @@
 (the colourings and the trust mask of render/maps/fractal.py), and the legend's swatches in the same colours.
 
 Painting is the map's half that draws: Map (fractal.py) and FtleMap (ftle.py) inherit it and set what it reads
-(the scene and layout, the event and faithful-time fields, the colour scales). An event map (flip_time,
-divergence) keeps its plot between frames: a pixel whose points have all settled, or cannot flip, keeps its
-colour, so only the pixels still pending, or settled since the last frame, are painted again; at the end of a
-20 s flip map, 7 % of them.
+(the scene and layout, the event and faithful-time fields, a divergence map's pair distances, the colour
+scales). An event map (flip_time, divergence) keeps its plot between frames: a pixel whose points have all
+settled, or cannot flip, keeps its colour, so only the pixels still pending, or settled since the last frame,
+are painted again; at the end of a 20 s flip map, 7 % of them.
 """
 
 import math
@@ -140,9 +140,7 @@ class Painting:
             elif ev == NEVER:
                 claim = 0.0  # settled by energy, not by the integration
             elif ti.static(self.twins):
-                a, b = 2 * j, 2 * j + 1
-                col = self.together(ti.sqrt((self.sim.q[a] - self.sim.q[b]).norm_sqr()
-                                            + (self.sim.v[a] - self.sim.v[b]).norm_sqr()))
+                col = self.together(self.apart[j])  # the pair's distance, kept by the advance
             else:
                 col = ti.Vector([PENDING_GREY] * 3)
         if claim > self.until[p]:
