@@ -9,10 +9,10 @@ adding them can change a byte: the same bytes at any thread count, on any CPU. A
 rounded to nearest, a half up.
 
 Two Taichi kernels, rows then columns. The rows pass reads the frame in words of 4 bytes (a row that is not
-whole words is padded): it took 2.4 ms of a 720p frame reading bytes, 1.5 ms reading words. fractal_flip's 720p frames
-shrink to 352×198 in 3.1-3.2 ms of CPU each, where numpy, with floats for the cut pixels, took 8.5-8.7 ms
-(random bytes: 12-14 ms); a 20 s map's GIF is 400 of them (`python benchmarks/shrink_time.py`, this and the
-numpy version alternating, 2 rounds each; 2-core Xeon, AVX-512, 2026-12-06).
+whole words is padded): it took 2.4 ms of a 720p frame reading bytes, 1.5 ms reading words. fractal_flip's
+720p frames shrink to 352×198 in 3.1-3.2 ms of CPU each, where numpy, with floats for the cut pixels, took
+8.5-8.7 ms (random bytes: 12-14 ms); a 20 s map's GIF is 400 of them (`python benchmarks/shrink_time.py`, this
+and the numpy version alternating, 2 rounds each; 2-core Xeon, AVX-512, 2026-12-06).
 """
 import functools
 
