@@ -81,9 +81,9 @@ class Map(Painting, runtime.Launcher):
         self.pending = runtime.field("fractal.pending", ti.i32, self.points)  # the points with an event ahead
         self.n_pending = runtime.field("fractal.n_pending", ti.i32, ())
         # divergence: each pair's distance where the advance left it, for the paint's grey. Both states read again
-        # there were 64 bytes a pixel, which beside x264 cost: fractal_divergence's renders drew in 11.1 and 10.4 s
-        # that way, 6.8 and 6.7 s this way (alternating); alone, in benchmarks/map_frame.py, no difference showed
-        # (6.1-6.6 ms a frame either way)
+        # there were 64 bytes a pixel, which beside x264 cost: `pendulum render fractal_divergence` drew in 11.1
+        # and 10.4 s that way, 6.8 and 6.7 s this way (alternating, metadata.json's timings); alone, in
+        # `python benchmarks/map_frame.py fractal_divergence --seconds 2`, no difference showed (6.1-6.6 ms a frame)
         self.apart = runtime.field("fractal.apart", runtime.real(), self.points if self.twins else 1)
         self.until = self.faithful(cert)
         self.font = Font(self.lay.font) if self.lay.font else None

@@ -9,10 +9,11 @@ adding them can change a byte: the same bytes at any thread count, on any CPU. A
 rounded to nearest, a half up.
 
 Two Taichi kernels, rows then columns. The rows pass reads the frame in words of 4 bytes (a row that is not
-whole words is padded): it took 2.4 ms of a 720p frame reading bytes, 1.5 ms reading words. fractal_flip's
-720p frames shrink to 352×198 in 3.1-3.2 ms of CPU each, where numpy, with floats for the cut pixels, took
-8.5-8.7 ms (random bytes: 12-14 ms); a 20 s map's GIF is 400 of them (`python benchmarks/shrink_time.py`, this
-and the numpy version alternating, 2 rounds each; 2-core Xeon, AVX-512, 2026-12-06).
+whole words is padded: reading bytes took it 2.4 ms of a 720p frame, words 1.5 ms, timed by a script not
+kept). fractal_flip's 720p frames shrink to 352×198 in 3.1-3.2 ms of CPU each, where numpy, with floats for the
+cut pixels, took 8.5-8.7 ms (random bytes: 12-14 ms); a 20 s map's GIF is 400 of them (`python
+benchmarks/shrink_time.py`, this and the numpy version alternating, 2 rounds each; 2-core Xeon, AVX-512,
+2026-12-06).
 """
 import functools
 
@@ -102,7 +103,8 @@ def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
         words = np.concatenate([words, np.zeros((H, -span % 4), np.uint8)], axis=1)
     stride = words.shape[1]
     # On two CPUs or fewer on the launching thread, as yuv.convert: the encoders hold the other core, and the
-    # thread pool's wake-up cost more CPU than it saved (2.5 ms wall and 3.6 ms CPU a frame on two threads)
+    # thread pool's wake-up cost more CPU than it saved (2.5 ms wall and 3.6 ms CPU a frame on two threads, by the
+    # script not kept above; on the launching thread 2.9 ms of both)
     one = serial()
     rows = np.empty(h * stride, np.int32)
     _rows(words.reshape(-1).view(np.uint32), rows, fy, sy, H, stride // 4, one)

@@ -59,8 +59,8 @@ SERIAL_THREADS = 2
 
 
 def serial() -> bool:
-    """Whether a frame's conversion runs on the launching thread (SERIAL_THREADS); on CUDA a loop is never
-    serialised (that would be one GPU thread)."""
+    """Whether a frame's conversion, or its shrink (render/video/downscale.py), runs on the launching thread
+    (SERIAL_THREADS); on CUDA a loop is never serialised (that would be one GPU thread)."""
     cfg = ti.lang.impl.current_cfg()
     return cfg.arch != ti.cuda and cfg.cpu_max_num_threads <= SERIAL_THREADS
 
