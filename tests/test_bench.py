@@ -161,9 +161,9 @@ def fake_results(numba=True):
                "integrator": {"method": "rk4", "dt": 2e-3, "substeps": 9, "precision": "f64"},
                "map": {"plot": {"width": 640}, "events": 3, "events_trusted": 3}}
     res = {"sim": {"rows": rows, "peak": pk}, "encode": {"draw_fps": 200.0, "sim_draw_fps": 180.0, "floor_s": 1.0,
-                                                         "encode_fps": 120.0},
-           "e2e": {"wall_s": 1.2, "frames": 120, "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4},
-                   "fixed_s": 0.3},
+                                                         "floor_rounds_s": [0.9, 1.1], "encode_fps": 120.0},
+           "e2e": {"wall_s": 1.2, "rounds_s": [1.3, 1.1], "frames": 120,
+                   "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4}, "fixed_s": 0.3},
            "hud": {"frames": 118, "ms": 0.8, "size": "1280x720"}, "matplotlib": mpl,
            "rainbow": {"frames": 178, "draw_fps": 40.0, "sim_fps": 300.0, "size": "1280x720", "effects": ["rods"]},
            **{f"fractal_{c}": {**fractal, "preset": p} for c, p in bench.FRACTALS.items()}}
@@ -187,6 +187,12 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     t = rep["targets"]
     assert set(t) == TARGETS and t["matplotlib_draw_ratio"]["spread"] == rep["spread"]["matplotlib_draw_ratio"]
     assert t["hud_ms_720p"] == {"value": 0.8, "goal": "<= 1", "met": True, "value_over_goal": 0.8, "spread": None}
+    # the render and the floor, once a round: the medians' ratio, and round by round 1.3 / 0.9 and 1.1 / 1.1
+    e2e, rt = t["end_to_end_over_encode_floor"], t["render_over_realtime"]
+    assert e2e["value"] == pytest.approx(1.2) and e2e["spread"]["value"] == pytest.approx(1.2)
+    assert (e2e["spread"]["min"], e2e["spread"]["max"]) == (pytest.approx(1.0), pytest.approx(1.3 / 0.9))
+    chaos_s = bench.QUICK["chaos_s"]
+    assert rt["value"] == pytest.approx(1.2 / chaos_s) and rt["spread"]["max"] == pytest.approx(1.3 / chaos_s)
     goal, met, speedup = {"avx2": ("3.5e+07", True, "15"), "avx512": ("5.5e+07", False, "8")}[kind]
     f64 = t["rigid_f64_steps_per_s_1e5"]  # 5e7 steps/s: past AVX2's 3.5e7, short of AVX-512's 5.5e7
     assert f64["goal"] == f">= {goal}" and f64["met"] is met
@@ -194,6 +200,7 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     md = bench_report.markdown(rep)
     assert "| matplotlib_draw_ratio | 14.1 | 13.3..15 (12 %) |" in md and "**0.278** (0.250..0.300 (18 %))" in md
     assert f"{kind} targets" in md and "load average" in md
+    assert "| end-to-end render | 1.20 s (rounds 1.30, 1.10 s) |" in md
 
 
 def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):

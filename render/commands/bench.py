@@ -39,9 +39,9 @@ SIZE = ["video.width=1280", "video.height=720"]
 # whole 10 s too: its fps counts the certificate, about 1.2 s at 720p whatever the length, which was a tenth
 # of a 2 s map's wall (9.89 fps there, 2026-12-04) and is a fiftieth of the map a user renders. The others cost
 # about the same every frame, so 2 s tell (the FTLE map, 10 to 20 times a plain advance per frame, 1 s).
-# rounds: interleaved rounds of every comparison with a peer (--repeat); peer_s: seconds of rigid_chaos that
-# both sides render and draw in the matplotlib phase (10 s: 600 frames); warm_maps: render a map's first frame
-# before timing it (phase_fractal).
+# rounds: interleaved rounds of every comparison with a peer, and how many times the end-to-end render and its
+# encode floor are timed (--repeat); peer_s: seconds of rigid_chaos that both sides render and draw in the
+# matplotlib phase (10 s: 600 frames); warm_maps: render a map's first frame before timing it (phase_fractal).
 FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None, "peer_s": 10.0,
         "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": None, "lyapunov": 1.0}, "rounds": 3,
         "warm_maps": True}
@@ -64,8 +64,8 @@ def add_parser(sub):
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
     p.add_argument("--repeat", type=lambda t: positive_int(t, MAX_ROUNDS), metavar="R",
-                   help=f"interleaved rounds of each comparison with a peer, 1 to {MAX_ROUNDS} "
-                        "(default: 3; --quick: 2)")
+                   help=f"interleaved rounds of each comparison with a peer, and the number of timed "
+                        f"rigid_chaos renders and encode floors, 1 to {MAX_ROUNDS} (default: 3; --quick: 2)")
     p.add_argument("--phase", help=argparse.SUPPRESS)  # internal: run one phase in this process
     p.add_argument("--result", type=Path, help=argparse.SUPPRESS)
     p.set_defaults(func=run)
@@ -154,16 +154,19 @@ def phase_encode(cfg, arch, tmp) -> dict:
         gw, gh = small.w, small.h
         gif_frames = dict(zip(kept, np.memmap(raw_small, np.uint8, "r", shape=(len(kept), gh, gw, 3))))
     (tmp / "floor").mkdir(exist_ok=True)
-    t = time.perf_counter()
-    enc = Encoder(tmp / "floor", scene.name, v, scene.frames, planar=True)
-    for f in range(scene.frames):
-        enc.write(frames[f], gif_frames.get(f) if gif_frames else None)
-    enc.close()
-    floor = time.perf_counter() - t
+    floors = []  # one encode per round, as phase_e2e renders once per round
+    for _ in range(cfg["rounds"]):
+        t = time.perf_counter()
+        enc = Encoder(tmp / "floor", scene.name, v, scene.frames, planar=True)
+        for f in range(scene.frames):
+            enc.write(frames[f], gif_frames.get(f) if gif_frames else None)
+        enc.close()
+        floors.append(time.perf_counter() - t)
     del frames, gif_frames
     raw.unlink()
     raw_small.unlink()
-    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + simulate), "floor_s": floor,
+    floor = statistics.median(floors)
+    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + simulate), "floor_s": floor, "floor_rounds_s": floors,
             "encode_fps": scene.frames / floor}
 
 
@@ -178,11 +181,16 @@ def timed_render(scene, arch, tmp, warm_scene=None) -> tuple[float, dict]:
 
 
 def phase_e2e(cfg, arch, tmp) -> dict:
+    """rigid_chaos rendered once per round (--repeat), the first after a one-frame warm-up render: the median
+    wall time, each round's, and the median render's split; then a one-frame render, the fixed cost."""
     scene = chaos_scene(cfg)
     one = scene.replace(video={"duration": 1.0 / scene.video.fps})
-    wall, meta = timed_render(scene, arch, tmp, one)
+    runs = [timed_render(scene, arch, tmp, one if r == 0 else None) for r in range(cfg["rounds"])]
+    walls = [wall for wall, _ in runs]
+    _, meta = sorted(runs, key=lambda run: run[0])[(len(runs) - 1) // 2]  # the median's split (the lower of two)
     fixed, _ = timed_render(one, arch, tmp)  # what every render pays besides its frames
-    return {"wall_s": wall, "frames": meta["frames"], "timings": meta["timings_s"], "fixed_s": fixed}
+    return {"wall_s": statistics.median(walls), "rounds_s": walls, "frames": meta["frames"],
+            "timings": meta["timings_s"], "fixed_s": fixed}
 
 
 def phase_fractal(colouring, cfg, arch, tmp) -> dict:

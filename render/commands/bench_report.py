@@ -53,6 +53,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "rainbow_1000_draw_fps": rb["draw_fps"], "rainbow_1000": rb,
            "draw_fps": enc["draw_fps"], "sim_draw_fps": enc["sim_draw_fps"], "encode_fps": enc["encode_fps"],
            "end_to_end_s": e2e["wall_s"], "encode_floor_s": enc["floor_s"], "frames": e2e["frames"],
+           "end_to_end_rounds_s": e2e["rounds_s"], "encode_floor_rounds_s": enc["floor_rounds_s"],
            "end_to_end_fixed_s": e2e["fixed_s"], "end_to_end_timings": e2e["timings"], "fractal": fr,
            "sim": res["sim"]["rows"], "peak_mem_mb": {k: v["peak_mem_mb"] for k, v in res.items()}, "targets": {},
            **peers.throughput_keys(rows, e2e["wall_s"], chaos_s, mpl),
@@ -61,7 +62,10 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "peak_gflops": {p: v["peak_gflops"] for p, v in pk.items()},
            "rigid_rk4_peak_fraction": {p: v["fraction"]["value"] for p, v in pk.items()}, "peak": pk,
            "spread": {**peers.spreads(rows, mpl), **{f"rigid_rk4_peak_fraction.{p}": v["fraction"]
-                                                     for p, v in pk.items()}},
+                                                     for p, v in pk.items()},
+                      # a render and a floor per round, in phases of their own: round i's render over its floor
+                      "render_over_realtime": peers.ratio(e2e["rounds_s"], [chaos_s] * len(e2e["rounds_s"])),
+                      "end_to_end_over_encode_floor": peers.ratio(e2e["rounds_s"], enc["floor_rounds_s"])},
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING},
            "compiled": {k: v["compiled"] for k, v in res.items() if v.get("compiled")},  # kernels, by phase
            "rerun": [k for k, v in res.items() if v.get("rerun")]}
@@ -91,6 +95,11 @@ def fmt(val, spec=".3g") -> str:
 def spread_text(s: dict | None, spec=".3g") -> str:
     """A ratio's per-round range and its width in % of the ratio; blank for a figure that is not a ratio."""
     return "" if s is None else f"{s['min']:{spec}}..{s['max']:{spec}} ({s['spread_pct']:.0f} %)"
+
+
+def rounds_text(seconds: list[float]) -> str:
+    """Each round's time, in the order they ran: the median beside it is one of them (or between two)."""
+    return "rounds " + ", ".join(f"{x:.2f}" for x in seconds) + " s"
 
 
 def with_spread(s: dict | None, spec=".2f") -> str:
@@ -154,8 +163,8 @@ def markdown(r: dict) -> str:
         ["simulate + draw, no encoding", f"{r['sim_draw_fps']:.0f} fps"],
         ["draw only", f"{r['draw_fps']:.0f} fps"],
         ["encode only: the floor (same frames, same Encoder)",
-         f"{r['encode_fps']:.0f} fps, {r['encode_floor_s']:.2f} s"],
-        ["end-to-end render", f"{r['end_to_end_s']:.2f} s"],
+         f"{r['encode_fps']:.0f} fps, {r['encode_floor_s']:.2f} s ({rounds_text(r['encode_floor_rounds_s'])})"],
+        ["end-to-end render", f"{r['end_to_end_s']:.2f} s ({rounds_text(r['end_to_end_rounds_s'])})"],
         ["end-to-end / floor", f"**{r['end_to_end_over_encode_floor']:.3f}**"],
         ["fixed cost in it (a one-frame render)", f"{r['end_to_end_fixed_s']:.2f} s"],
         ["render's split: simulate / draw / waiting for the encoder",
