@@ -104,7 +104,7 @@ def test_frames_are_byte_identical_at_1_and_2_threads_and_the_legend_is_in_1_per
     assert iio.imread(d / "fractal_lyapunov.png").tobytes() == a[-1].tobytes()
     m = json.loads((d / "metadata.json").read_text())["map"]
     assert m["colouring"] == "lyapunov" and m["sigma_scale_per_s"] == [0.0, ftle.SIGMA_MAX]
-    assert {"ftle_frame", "ftle_renormalise", "ftle_colour", "fractal_swatch"} <= set(meta["kernels"])
+    assert {"ftle_frame", "ftle_colour", "fractal_swatch"} <= set(meta["kernels"])
     decor = axes.decorate(scene, grid.layout(1280, 720), (0.0, ftle.SIGMA_MAX), "")  # at 720p: the bar's ticks
     labels = [t[0] for t in decor.texts]
     assert "σ [1/s]" in labels and {"0.2", "1", "1.8", "2"} <= set(labels) and "barrier" in " ".join(labels)

@@ -7,15 +7,14 @@ the coordinates the divergence map measures distance in; a triple pendulum's map
 singular value; σ in 1/s.
 
 **The tangent map, exactly.** Every pixel carries four tangent vectors, the columns of M = DΦ(t)·e^{−L}
-(M = I at t = 0). Each frame, one forward-mode kernel (ti.ad.FwdMode, as in render/physics/tangent.py) runs the
-scene's own integrator over the system's own force through the frame, once per column: the four columns
-are four lanes of the same loop, each the pixel's state with that column as its dual, so the duals that come
-out are DΦ_frame·M to round-off (not a finite difference, and no physics written here). Lane 0's primal
-is the pixel's new state. Then M is divided by its largest entry m and L += ln m, which keeps it finite for
-any t; nothing else is done to it. No QR: the columns are left to align with the stretching direction, which
-loses the smaller singular values to round-off but not the largest, since s_max is well conditioned
-(|s_max(M + E) − s_max(M)| ≤ |E|), so ln s_max(DΦ(t)) = L + ln s_max(M) is the finite-t value, not the
-asymptotic rate a renormalised basis would give.
+(M = I at t = 0). Each frame, one kernel runs the scene's own integrator over the system's own force through
+the frame with the pixel's state as a forward-mode Dual (render/physics/dual.py) whose four tangents are M's
+columns: its value is the pixel's new state, the very steps the plain advance takes (the same bits), and its
+tangents are DΦ_frame·M to round-off (not a finite difference, and no physics written here). Then M is divided
+by its largest entry m and L += ln m, which keeps it finite for any t; nothing else is done to it. No QR: the
+columns are left to align with the stretching direction, which loses the smaller singular values to round-off
+but not the largest, since s_max is well conditioned (|s_max(M + E) − s_max(M)| ≤ |E|), so ln s_max(DΦ(t)) = L +
+ln s_max(M) is the finite-t value, not the asymptotic rate a renormalised basis would give.
 
 **s_max per pixel.** s_max(M)² = λ_max(MᵀM): MᵀM is squared ten times (normalised each time), so that a
 column of it points along the top eigenvector but for a part (λ2/λ1)^1024, and that column's Rayleigh
@@ -31,24 +30,20 @@ hatched past the faithful time of its lattice neighbours. With map.samples = 4 o
 its own tangent vectors and σ, the barrier's curve is found on the samples' own finer grid (a sample on it is
 black), and a pixel shows its samples' colours averaged as render/maps/paint.py paints every map.
 
-**Trig.** Taichi's forward mode cannot differentiate render/physics/sincos.py's inline sin/cos, so the tangent
-kernel steps a libm twin of the system (tangent.libm_twin) and its primal is the map's state. The preset
-runs in f64, where libm's sin/cos and the inline ones the certificate checks differ by about an ulp (far
-below its tolerance), and where libm's last bits, which differ between CPUs, do not grow into a different
-picture within the video as they would in a chaotic f32 map (docs/numerics.md). libm calls do not
-vectorise, and each lane carries a dual beside its primal: a frame costs 10 to 20 times the plain
-vectorised advance of the same pixels (measured on the shared 2-core machine, indicative only: 3 to 5 s a
-frame at 720p, 17 substeps), far from video speed; a forward mode through a differentiable inline sin/cos
-in the vectorised loop is the way to close that gap.
+**Cost.** The points go through the frame in the system's groups, in the loop System.advance_group vectorises,
+with the scene's own sin and cos (inline, render/physics/sincos.py, unless it pins libm). At 720p (381,924
+points, 17 RK4 substeps) a frame's simulation took 2.13 s when each tangent was a lane of Taichi's forward mode
+through a libm twin of the system, and 0.18 s this way (`python benchmarks/map_frame.py fractal_lyapunov
+--seconds 0.2`, 2-core Xeon, AVX-512, 2026-12-07); its drawing (s_max per pixel, not vectorised) 0.09 s.
 """
 
 import numpy as np
 import taichi as ti
 
 from . import colours, fractal, supersample
-from ..physics import grid, runtime, steps
+from ..physics import dual, grid, runtime, steps
 from ..draw.font import Font
-from ..physics.tangent import check_method, libm_twin, scalarized
+from ..physics.tangent import check_method
 
 SIGMA_MAX = 2.0  # 1/s: the top of the colour scale
 SQUARINGS = 10  # of MᵀM, for its top eigenvector
@@ -66,15 +61,8 @@ class FtleMap(fractal.Map):
         self.place(rows)  # one pendulum per point: pixel p's samples are p·samples + s
         self.lo, self.hi = 0.0, SIGMA_MAX  # the colour scale, in 1/s
         self.eps, self.log_ratio = scene.map.epsilon, 1.0  # Map.fractal_swatch compiles its distance branch too
-        self.twin = libm_twin(sim)
-        self.k = 2 * sim.D  # tangent vectors per pixel: the state's dimension (4 for the double pendulum)
-        real, n, D = runtime.real(), self.k * self.points, self.k  # one kernel element per tangent vector
-        # dx: a zero offset to the state, whose duals are the columns of M; out: the frame's end and its duals
-        self.dx = ti.Vector.field(D, real, shape=n, needs_dual=True)
-        self.out = ti.Vector.field(D, real, shape=n, needs_dual=True)
-        runtime.allocated["ftle.tangents"] = 4 * n * D * (8 if real == ti.f64 else 4)  # the two and their duals
-        self.loss = ti.field(real, shape=(), needs_dual=True)  # FwdMode's required (unused) loss and param:
-        self.unit = ti.field(real, shape=(), needs_dual=True)  # the seeds are dx's duals, set per element
+        self.k, real = 2 * sim.D, runtime.real()  # tangent vectors per point: the state's dimension (4 for rigid)
+        self.tan = runtime.field("ftle.tangents", real, (self.points, self.k), self.k)  # M's columns
         self.log_scale = runtime.field("ftle.log_scale", real, self.points)  # L
         self.sigma = runtime.field("ftle.sigma", real, self.points)  # σ_t as last drawn
         self.edge = runtime.field("ftle.barrier", ti.u8, self.points)
@@ -104,14 +92,11 @@ class FtleMap(fractal.Map):
 
     def advance(self, substeps: int, h: float):
         """One frame on, for the frame loop (render/physics/stepper.py, which keeps the clock)."""
-        self.out.dual.fill(0)  # forward mode adds into the output's duals
-        with scalarized(), ti.ad.FwdMode(loss=self.loss, param=self.unit, seed=[1.0], clear_gradients=False):
-            self.launch("ftle_frame", self.twin, substeps, h)
-        self.launch("ftle_renormalise")
+        self.launch("ftle_frame", substeps, h)
 
     def tangents(self) -> tuple[np.ndarray, np.ndarray]:
         """(M, L): per pixel the k×k matrix M (column k: the image of unit vector k) and L, DΦ(t) = M·e^L."""
-        m = self.dx.dual.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
+        m = self.tan.to_numpy().astype(np.float64).reshape(self.pixels, self.k, -1).transpose(0, 2, 1)
         return m, self.log_scale.to_numpy().astype(np.float64)
 
     def arrays(self) -> dict:
@@ -152,47 +137,64 @@ class FtleMap(fractal.Map):
 
     @ti.kernel
     def ftle_setup(self):
-        for e in range(self.k * self.points):
-            self.dx[e] = ti.Vector.zero(float, self.k)
-            self.dx.dual[e] = ti.Vector.unit(self.k, e % self.k, float)
-        for j in range(self.points):
-            self.log_scale[j], self.sigma[j] = 0.0, 0.0
-
-    @ti.kernel
-    def ftle_frame(self, sys: ti.template(), substeps: ti.i32, h: float):
-        """One frame of every point, four times: lane e % k with column e % k of its M as the state's dual."""
-        D = ti.static(self.sim.D)
-        for e in range(self.k * self.points):
-            p, d = e // self.k, self.dx[e]
-            q = ti.Matrix.cols([self.sim.q[p] + ti.Vector([d[c] for c in ti.static(range(D))])])
-            v = ti.Matrix.cols([self.sim.v[p] + ti.Vector([d[D + c] for c in ti.static(range(D))])])
-            for _ in range(substeps):
-                q, v = steps.step(sys, q, v, h)
-            self.out[e] = ti.Vector([q[c, 0] for c in ti.static(range(D))] + [v[c, 0] for c in ti.static(range(D))])
-
-    @ti.kernel
-    def ftle_renormalise(self):
-        """The new state (lane 0's primal), M = the frame's images over their largest entry m, L += ln m."""
-        D, K = ti.static(self.sim.D, self.k)
+        for p, k in self.tan:
+            self.tan[p, k] = ti.Vector.unit(self.k, k, float)
         for p in range(self.points):
-            m = 0.0
+            self.log_scale[p], self.sigma[p] = 0.0, 0.0
+
+    @ti.kernel
+    def ftle_frame(self, substeps: ti.i32, h: float):
+        """One frame of every point and its tangent vectors, in the system's groups (System.advance's loop)."""
+        S = ti.static(runtime.SPREAD)
+        for t in range(self.sim.groups * S):
+            if t % S == 0:
+                self.frame_group(t // S, substeps, h)
+
+    @ti.func
+    def frame_group(self, g, substeps, h):
+        """Group g's points through one frame, each with its K tangent vectors as a Dual's tangents (see the
+        module's docstring): the loop over lanes is System.advance_group's, which LLVM vectorises. Then each
+        point's new state, and M = the images over their largest entry m, L += ln m."""
+        sim = self.sim
+        B, D, K = ti.static(sim.chunk, sim.D, self.k)
+        Q, V = ti.Matrix.zero(float, D, B), ti.Matrix.zero(float, D, B)
+        TQ, TV = ti.Matrix.zero(float, K * D, B), ti.Matrix.zero(float, K * D, B)  # row k·D + c: column k's
+        for lane in range(B):
+            p = ti.min(g * B + lane, sim.n - 1)
+            Q[:, lane], V[:, lane] = sim.q[p], sim.v[p]
             for k in ti.static(range(K)):
-                m = ti.max(m, ti.abs(self.out.dual[K * p + k]).max())
-            ok = m > 0.0 and m < 1e30  # also NaN
-            if ok:
+                m = self.tan[p, k]
+                for c in ti.static(range(D)):
+                    TQ[k * D + c, lane], TV[k * D + c, lane] = m[c], m[D + c]
+        for _ in range(substeps):
+            for lane in range(B):  # the loop LLVM vectorises
+                q = dual.Dual(ti.Matrix.cols([Q[:, lane]]), [ti.Matrix.cols([ti.Vector(
+                    [TQ[k * D + c, lane] for c in ti.static(range(D))])]) for k in ti.static(range(K))])
+                v = dual.Dual(ti.Matrix.cols([V[:, lane]]), [ti.Matrix.cols([ti.Vector(
+                    [TV[k * D + c, lane] for c in ti.static(range(D))])]) for k in ti.static(range(K))])
+                q, v = steps.step(sim, q, v, h)
+                Q[:, lane], V[:, lane] = q.v[:, 0], v.v[:, 0]
                 for k in ti.static(range(K)):
-                    self.dx.dual[K * p + k] = self.out.dual[K * p + k] / m
-                self.log_scale[p] += ti.log(m)
-            x = self.out[K * p]
-            self.sim.q[p] = ti.Vector([x[c] for c in ti.static(range(D))])
-            self.sim.v[p] = ti.Vector([x[D + c] for c in ti.static(range(D))])
-            self.sim.watch(p, x, ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
+                    for c in ti.static(range(D)):
+                        TQ[k * D + c, lane], TV[k * D + c, lane] = q.d[k][c, 0], v.d[k][c, 0]
+        for lane in range(B):
+            p = g * B + lane
+            if p < sim.n:
+                m = ti.max(ti.abs(TQ[:, lane]).max(), ti.abs(TV[:, lane]).max())
+                ok = m > 0.0 and m < 1e30  # also NaN
+                if ok:
+                    for k in ti.static(range(K)):
+                        self.tan[p, k] = ti.Vector([TQ[k * D + c, lane] for c in ti.static(range(D))]
+                                                   + [TV[k * D + c, lane] for c in ti.static(range(D))]) / m
+                    self.log_scale[p] += ti.log(m)
+                sim.q[p], sim.v[p] = Q[:, lane], V[:, lane]
+                sim.watch(p, Q[:, lane], ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
 
     @ti.func
     def log_smax(self, p):
         """ln s_max(M) of point p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
         K = ti.static(self.k)
-        m = ti.Matrix.cols([self.dx.dual[K * p + k] for k in ti.static(range(K))])
+        m = ti.Matrix.cols([self.tan[p, k] for k in ti.static(range(K))])
         b = m.transpose() @ m
         c = b
         for _ in range(SQUARINGS):

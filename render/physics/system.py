@@ -14,7 +14,7 @@ contract (LINKS, bob_sizes(), reach(), lengths). Only stepper.Run builds one wit
 import numpy as np
 import taichi as ti
 
-from . import crossings, runtime, steps
+from . import crossings, dual, runtime, steps
 from .plan import Plan
 from .recording import Recording
 from .sincos import sincos
@@ -117,7 +117,15 @@ class System(Plan, Recording, runtime.Launcher):
     # --------------------------------------------------------------- shared Taichi parts
     @ti.func
     def sincos(self, x):
-        """(sin x, cos x) for accel: inline (render/physics/sincos.py) unless the scene asks for libm's exact bits."""
+        """(sin x, cos x) for accel: inline (render/physics/sincos.py) unless the scene asks for libm's exact bits;
+        of a Dual (render/physics/dual.py), the same values and their derivatives."""
+        if ti.static(dual.is_dual(x)):
+            return dual.sincos(x, self.trig)
+        else:
+            return self.trig(x)
+
+    @ti.func
+    def trig(self, x):
         if ti.static(self.libm):
             return ti.sin(x), ti.cos(x)
         else:

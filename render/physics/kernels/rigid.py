@@ -1,6 +1,7 @@
 """The rigid double pendulum in Taichi: Lagrange's equations for θ1'', θ2'' (angles from the downward vertical)."""
 import taichi as ti
 
+from .. import dual
 from ..system import System
 from ..systems.rigid import Rigid
 
@@ -21,7 +22,7 @@ class RigidKernels(Rigid, System):
               - 2.0 * sd * m2 * (w2 * w2 * l2 + w1 * w1 * l1 * cd)) / (l1 * den)
         a2 = (2.0 * sd * (w1 * w1 * l1 * (m1 + m2) + g * (m1 + m2) * c1
                           + w2 * w2 * l2 * m2 * cd)) / (l2 * den)
-        return ti.Matrix.rows([a1, a2])
+        return dual.rows([a1, a2])  # of Duals too: the FTLE map carries tangents through (render/physics/dual.py)
 
     @ti.func
     def energy(self, q, v):

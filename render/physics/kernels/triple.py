@@ -6,6 +6,7 @@ solved for θ'' by the explicit inverse of the symmetric 3×3 M (cofactors), lan
 """
 import taichi as ti
 
+from .. import dual
 from ..system import System
 from ..systems.triple import Triple
 
@@ -36,8 +37,8 @@ class TripleKernels(Triple, System):
         i00, i01, i02 = d * k - e * e, c * e - b * k, b * e - c * d
         i11, i12, i22 = a * k - c * c, b * c - a * e, a * d - b * b
         det = a * i00 + b * i01 + c * i02
-        return ti.Matrix.rows([(i00 * f0 + i01 * f1 + i02 * f2) / det, (i01 * f0 + i11 * f1 + i12 * f2) / det,
-                               (i02 * f0 + i12 * f1 + i22 * f2) / det])
+        return dual.rows([(i00 * f0 + i01 * f1 + i02 * f2) / det, (i01 * f0 + i11 * f1 + i12 * f2) / det,
+                          (i02 * f0 + i12 * f1 + i22 * f2) / det])
 
     @ti.func
     def accel(self, q, v):
