@@ -34,7 +34,8 @@ black), and a pixel shows its samples' colours averaged as render/maps/paint.py 
 with the scene's own sin and cos (inline, render/physics/sincos.py, unless it pins libm). At 720p (381,924
 points, 17 RK4 substeps) a frame's simulation took 2.13 s when each tangent was a lane of Taichi's forward mode
 through a libm twin of the system, and 0.18 s this way (`python benchmarks/map_frame.py fractal_lyapunov
---seconds 0.2`, 2-core Xeon, AVX-512, 2026-12-07); its drawing (s_max per pixel, not vectorised) 0.09 s.
+--seconds 0.2`, 2-core Xeon, AVX-512, 2026-12-06). Its drawing, σ of every point (FtleMap.ftle_sigma) then the
+colours, took 0.035 s.
 """
 
 import numpy as np
@@ -190,30 +191,70 @@ class FtleMap(fractal.Map):
                 sim.q[p], sim.v[p] = Q[:, lane], V[:, lane]
                 sim.watch(p, Q[:, lane], ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
 
+    def draw(self, out=None, t=None):
+        """σ_t of every point, then the map painted from it (paint.py)."""
+        self.launch("ftle_sigma", self.sim.t)
+        return super().draw(out, t)
+
+    @ti.kernel
+    def ftle_sigma(self, t: ti.f32):
+        """σ_t of every point into sigma, before the colours are painted from it: in the system's groups, the
+        lanes' MᵀM squared in loops LLVM vectorises (as System.advance_group's), their logarithm (a libm call)
+        after them. The same bits as when each pixel's colour worked out its own σ, serially (fractal_lyapunov,
+        its first 3 s at 640×360: σ, the last frame, the MP4 and the GIF compared), and a 720p frame's drawing
+        91.4 → 34.9 ms (`python benchmarks/map_frame.py fractal_lyapunov --seconds 0.2`, 2-core Xeon, AVX-512)."""
+        S = ti.static(runtime.SPREAD)
+        for g in range(self.sim.groups * S):
+            if g % S == 0:
+                self.sigma_group(g // S, t)
+
     @ti.func
-    def log_smax(self, p):
-        """ln s_max(M) of point p: half the log of MᵀM's top eigenvalue (see the module's docstring)."""
-        K = ti.static(self.k)
-        m = ti.Matrix.cols([self.tan[p, k] for k in ti.static(range(K))])
-        b = m.transpose() @ m
-        c = b
+    def sigma_group(self, g, t):
+        """σ_t of group g's points: each step a loop over the lanes with no call and no store to a field, the
+        innermost loop, which LLVM vectorises (unrolling the squarings in one lane loop did as well, but took
+        6 s longer to compile)."""
+        B, n, K = ti.static(self.sim.chunk, self.sim.n, self.k)
+        b, c = ti.Matrix.zero(float, K * K, B), ti.Matrix.zero(float, K * K, B)  # MᵀM and its powers, row-major
+        for lane in range(B):
+            m = ti.Matrix.cols([self.tan[ti.min(g * B + lane, n - 1), k] for k in ti.static(range(K))])
+            mm = m.transpose() @ m
+            b[:, lane] = ti.Vector([mm[i, j] for i, j in ti.static(ti.ndrange(K, K))])
+            c[:, lane] = b[:, lane]
         for _ in range(SQUARINGS):
-            c = c @ c
-            c /= ti.abs(c).max()
+            for lane in range(B):
+                x = ti.Matrix([[c[i * K + j, lane] for j in ti.static(range(K))] for i in ti.static(range(K))])
+                x = x @ x
+                x /= ti.abs(x).max()
+                c[:, lane] = ti.Vector([x[i, j] for i, j in ti.static(ti.ndrange(K, K))])
+        top = ti.Vector.zero(float, B)  # λ_max(MᵀM) of each lane
+        for lane in range(B):
+            top[lane] = self.rayleigh(b[:, lane], c[:, lane])
+        for lane in range(B):
+            j = g * B + lane
+            if j < n:
+                s = 0.0
+                if t > 0.0:
+                    s = (self.log_scale[j] + 0.5 * ti.log(top[lane])) / t  # ln s_max(M) = ½ ln λ_max(MᵀM)
+                self.sigma[j] = s
+
+    @ti.func
+    def rayleigh(self, b, c):
+        """λ_max(MᵀM) = s_max(M)² (see the module's docstring), from b = MᵀM and c = (MᵀM)^1024 normalised, both
+        row-major: the Rayleigh quotient of c's column with the largest norm (the first such on a tie)."""
+        K = ti.static(self.k)
         best, x = 0.0, ti.Vector.zero(float, K)
         for k in ti.static(range(K)):
-            n = c[:, k].norm_sqr()
-            if n > best:
-                best, x = n, c[:, k]
-        return 0.5 * ti.log(x.dot(b @ x) / x.norm_sqr())
+            col = ti.Vector([c[i * K + k] for i in ti.static(range(K))])
+            n = col.norm_sqr()
+            better = n > best
+            best, x = ti.select(better, n, best), ti.select(better, col, x)
+        bm = ti.Matrix([[b[i * K + j] for j in ti.static(range(K))] for i in ti.static(range(K))])
+        return x.dot(bm @ x) / x.norm_sqr()
 
     @ti.func
     def point_colour(self, j, p, t, c, r):
-        """Point j's colour (of pixel p, at column c and row r), σ_t kept in sigma."""
-        s = 0.0
-        if t > 0.0:
-            s = (self.log_scale[j] + self.log_smax(j)) / t
-        self.sigma[j] = s
+        """Point j's colour (of pixel p, at column c and row r), from its σ_t (ftle_sigma)."""
+        s = self.sigma[j]
         col = colours.palette(s / SIGMA_MAX)
         if self.edge[j]:
             col = ti.Vector([0.0, 0.0, 0.0])
