@@ -28,6 +28,10 @@ from ..physics.integrators import METHOD
 from ..physics.keys import DRAWN
 
 RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
+# The FTLE map (render/maps/ftle.py) steps each point with its 2D tangent vectors beside it, as duals: its advance
+# took 3.25 times the plain advance of the same points (fractal_lyapunov at 720p, 381,924 points, 17 RK4 substeps:
+# 184.1 against 56.6 ms, medians of 5 alternating rounds, 2-core Xeon with AVX-512, 2026-12-06, a script not kept)
+FTLE_COST = 3.25
 # Measured on this project's 2-core AMD EPYC machine (/tmp scripts timing System.advance, Canvas.draw and
 # the Encoder on their own, 2026-12-01) while other work kept its load average at about 4: a quiet machine
 # is up to twice as fast (the bench report of 2026-11-23: 35.5 M rigid f64 steps/s at N = 1e5, 17 ms a
@@ -136,6 +140,8 @@ def physics(scene, rates: dict) -> tuple[dict, float, int]:
         h, substeps = pinned(scene, worst["dt"])
     i, n = scene.integrator, scene.pendulums.count
     parts["simulate"] = run_s(scene, rates, i.method, i.precision, substeps, n)
+    if scene.fractal == "lyapunov":
+        parts["simulate"] *= FTLE_COST
     certified = len(grid.trust_indices(scene)) if scene.fractal else min(n, certify.SUBSAMPLE)
     shadow = certify.shadow_scene(scene, h).integrator
     _, shadow_substeps = pinned(scene, shadow.dt)
