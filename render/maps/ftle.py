@@ -189,7 +189,8 @@ class FtleMap(fractal.Map):
                                                    + [TV[k * D + c, lane] for c in ti.static(range(D))]) / m
                     self.log_scale[p] += ti.log(m)
                 sim.q[p], sim.v[p] = Q[:, lane], V[:, lane]
-                sim.watch(p, Q[:, lane], ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
+                state = ti.Vector([Q[c, lane] for c in ti.static(range(D))] + [V[c, lane] for c in ti.static(range(D))])
+                sim.watch(p, state, ti.Vector([m, 1.0 / m]))  # a degenerate M (m = 0, 1/m = inf) too: σ is lost
 
     def draw(self, out=None, t=None):
         """σ_t of every point, then the map painted from it (paint.py)."""
