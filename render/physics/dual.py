@@ -21,6 +21,8 @@ relative (a script not kept); tests/test_dual.py holds them to central differenc
 Taichi's front end takes a Dual as it is: its arithmetic returns NotImplemented for one (patched below, so that
 Python then asks the Dual), an object marked _data_oriented is passed into a ti.func without a copy, and
 assigning to a Dual variable assigns its parts, each a local variable (so a Dual may change in a loop or a branch).
+Those are Taichi 1.7.4's internals (impl.expr_init, impl.subscript, ops._binary_operation): pyproject.toml pins it,
+and tests/test_dual.py fails if a later one behaves otherwise.
 """
 import taichi as ti
 from taichi.lang import impl, ops
