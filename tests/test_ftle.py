@@ -111,6 +111,23 @@ def test_frames_are_byte_identical_at_1_and_2_threads_and_the_legend_is_in_1_per
     assert axes.linear_ticks(0.0, 2.0, 5) == [0.0, 0.5, 1.0, 1.5, 2.0]
 
 
+def test_the_map_steps_each_pixel_exactly_as_the_plain_advance_does():
+    """The tangents ride beside the state as duals (render/physics/dual.py): the state is the plain advance's, to
+    the bit, in the same vectorised group loop (so the certificate's trig is the map's)."""
+    src = pipeline.Source(small(40, 1.0))
+    mp, sim = src.canvas, src.sim
+    q0, v0 = sim.q.to_numpy(), sim.v.to_numpy()
+    for _ in range(4):
+        mp.advance(sim.substeps, sim.h)
+    mapped = sim.q.to_numpy().tobytes() + sim.v.to_numpy().tobytes()
+    sim.q.from_numpy(q0)
+    sim.v.from_numpy(v0)
+    for _ in range(4):
+        sim.advance_by(sim.substeps, sim.h)
+    assert mapped == sim.q.to_numpy().tobytes() + sim.v.to_numpy().tobytes()
+    assert np.abs(sim.q.to_numpy() - q0).max() > 0.01  # they moved
+
+
 def test_an_integrator_without_a_tangent_map_exits_2_naming_the_key(tmp_path):
     r = run_cli("render", "fractal_lyapunov", "--out", tmp_path, "--set", "integrator.method=implicit_midpoint",
                 "--set", "video.width=64", "--set", "video.height=36", "--set", "video.duration=0.1")
