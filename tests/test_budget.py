@@ -111,6 +111,21 @@ def test_drawing_and_encoding_count(tmp_path):
     assert 8 < draw["big"] / draw["small"] < 36  # 36 times the pixels, the fixed costs a frame aside
 
 
+def test_an_ftle_maps_sigma_counts_as_drawing():
+    """fractal_lyapunov's colours are σ of each point's MᵀM, every frame (render/maps/ftle.py): its draw+encode is
+    the same map's coloured by angle plus FTLE_SIGMA_STEPS plain rigid f64 RK4 steps per point and frame, and a
+    triple pendulum's 6×6 matrix (3.375 times the multiplications of a 4×4) costs that much more."""
+    size = ["video.width=320", "video.height=180", "video.duration=2"]
+    ftle = api.load("fractal_lyapunov", *size)
+    angles = ftle.replace(fractal="angles")
+    draw = {k: estimate.estimate(s, RATES).parts["draw+encode"] for k, s in (("ftle", ftle), ("angles", angles))}
+    sigma = ftle.frames * ftle.pendulums.count * estimate.FTLE_SIGMA_STEPS / RATES["steps_per_s"]["rigid_f64"]
+    assert draw["ftle"] - draw["angles"] == pytest.approx(sigma, rel=0.05) and sigma > 0.2 * draw["angles"]
+    triple = api.load("fractal_lyapunov", *size, 'system="triple"', "pendulums.lengths=[1.0, 1.0, 1.0]",
+                      "pendulums.masses=[1.0, 1.0, 1.0]")
+    assert estimate.sigma_s(triple, RATES) == pytest.approx(3.375 * estimate.sigma_s(ftle, RATES))
+
+
 def test_a_comparison_counts_the_sum_of_its_panels(tmp_path):
     """Four panels of 1e5 pendulums for 10 s: each panel alone, drawn at its size, is within the hour; all four
     are not."""

@@ -5,8 +5,8 @@ Parts: `start` (Taichi's start, the kernels' compiles, ffmpeg's start), `simulat
 `certificate` (render/trust/certify.py: the certified pendulums, up to 128, run again at the render's settings and
 by the shadow: RK4 at the same step, or an order-4 method at a quarter of it, in f64), `quality` (the pilot
 runs of --quality, render/trust/quality.py), and `draw+encode` (per frame: a fixed cost, a cost per pixel, one per
-drawn link, the HUD; x264 per pixel of every frame, the GIF's ffmpeg of every frame it keeps), or `write`
-for `simulate`'s .npz.
+drawn link, the HUD, an FTLE map's σ of every point; x264 per pixel of every frame, the GIF's ffmpeg of every
+frame it keeps), or `write` for `simulate`'s .npz.
 A comparison sums its panels (each variant simulated and certified, each panel drawn).
 
 Everything errs long: a --quality run is costed at the most expensive setting the pilots could choose, and
@@ -32,6 +32,12 @@ RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
 # took 3.25 times the plain advance of the same points (fractal_lyapunov at 720p, 381,924 points, 17 RK4 substeps:
 # 184.1 against 56.6 ms, medians of 5 alternating rounds, 2-core Xeon with AVX-512, 2026-12-06, a script not kept)
 FTLE_COST = 3.25
+# and its colours come from σ of each point's (2D)×(2D) MᵀM, squared ten times, every frame: 30 ms more than the
+# angles map's drawing of the same 381,924 points (36.5 against 6.2 ms a 720p frame, `python benchmarks/map_frame.py
+# fractal_lyapunov --seconds 0.2`, and fractal, 2-core Xeon, AVX-512, 2026-12-07), about the cost of 9 plain rigid
+# f64 RK4 steps of each point (115 M steps/s there). Counted as such, so it follows the machine's measured rate,
+# and as the cube of the matrix's side for another system.
+FTLE_SIGMA_STEPS = 9.0
 # Measured on this project's 2-core AMD EPYC machine (/tmp scripts timing System.advance, Canvas.draw and
 # the Encoder on their own, 2026-12-01) while other work kept its load average at about 4: a quiet machine
 # is up to twice as fast (the bench report of 2026-11-23: 35.5 M rigid f64 steps/s at N = 1e5, 17 ms a
@@ -124,8 +130,16 @@ def estimate(scene, rates: dict, source: str = "", simulate: bool = False) -> Es
         parts["write"] = grows = scene.frames * scene.pendulums.count * (2 * cls.D + 1) * 8 * rates["npz_byte_s"]
     else:
         per, links = picture_frame_s(scene, rates, panels)
+        if scene.fractal == "lyapunov":  # a map's points are its pixels: σ grows with the video, not a count
+            per += sigma_s(scene, rates)
         parts["draw+encode"], grows = scene.frames * per, scene.frames * links
     return Estimate(parts, steps, scene.frames, finest[0], finest[1], scene.pendulums.count, panels, source, grows)
+
+
+def sigma_s(scene, rates: dict) -> float:
+    """Seconds a frame of an FTLE map spends on σ of its points (FTLE_SIGMA_STEPS)."""
+    side = (2 * registry.get(scene.system).D / 4) ** 3  # 1 for the double pendulum's 4×4
+    return scene.pendulums.count * FTLE_SIGMA_STEPS * side / steps_per_s(rates, "rigid", "f64", "rk4")
 
 
 def physics(scene, rates: dict) -> tuple[dict, float, int]:
