@@ -59,6 +59,8 @@ def test_bench_quick_writes_report_json_and_md(tmp_path):
         s = rep["spread"][key]
         assert s["rounds"] == 2 and s["min"] <= s["max"] and s["spread_pct"] >= 0, (key, s)
         assert s["value"] == pytest.approx(at(rep, key)), key
+    hud = rep["spread"]["hud_ms_720p"]  # not a ratio: each round's median, and the median of those
+    assert hud["rounds"] == len(rep["hud"]["rounds_ms"]) == 2 and hud["min"] <= rep["hud_ms_720p"] <= hud["max"]
     assert 0 < rep["rigid_rk4_peak_fraction"]["f64"] < 1.5  # of a peak measured on the same cores
     assert set(rep["targets"]) == TARGETS
     for key, t in rep["targets"].items():  # a peer that did not run (numba not installed) is null, not a miss
@@ -164,7 +166,8 @@ def fake_results(numba=True):
                                                          "floor_rounds_s": [0.9, 1.1], "encode_fps": 120.0},
            "e2e": {"wall_s": 1.2, "rounds_s": [1.3, 1.1], "frames": 120,
                    "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4}, "fixed_s": 0.3},
-           "hud": {"frames": 118, "ms": 0.8, "size": "1280x720"}, "matplotlib": mpl,
+           "hud": {"frames": 118, "ms": 0.8, "rounds_ms": [0.9, 0.8], "spread": peers.spread([0.9, 0.8], 0.8),
+                   "size": "1280x720"}, "matplotlib": mpl,
            "rainbow": {"frames": 178, "draw_fps": 40.0, "sim_fps": 300.0, "size": "1280x720", "effects": ["rods"]},
            **{f"fractal_{c}": {**fractal, "preset": p} for c, p in bench.FRACTALS.items()}}
     for r in res.values():
@@ -186,7 +189,8 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     assert rep["spread"]["sim_speedup_vs_numba_1e5"]["max"] == pytest.approx(6.0 / 1.2)
     t = rep["targets"]
     assert set(t) == TARGETS and t["matplotlib_draw_ratio"]["spread"] == rep["spread"]["matplotlib_draw_ratio"]
-    assert t["hud_ms_720p"] == {"value": 0.8, "goal": "<= 1", "met": True, "value_over_goal": 0.8, "spread": None}
+    hud = {"value": 0.8, "min": 0.8, "max": 0.9, "spread_pct": pytest.approx(12.5), "rounds": 2}
+    assert t["hud_ms_720p"] == {"value": 0.8, "goal": "<= 1", "met": True, "value_over_goal": 0.8, "spread": hud}
     # the render and the floor, once a round: the medians' ratio, and round by round 1.3 / 0.9 and 1.1 / 1.1
     e2e, rt = t["end_to_end_over_encode_floor"], t["render_over_realtime"]
     assert e2e["value"] == pytest.approx(1.2) and e2e["spread"]["value"] == pytest.approx(1.2)
@@ -201,6 +205,7 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     assert "| matplotlib_draw_ratio | 14.1 | 13.3..15 (12 %) |" in md and "**0.278** (0.250..0.300 (18 %))" in md
     assert f"{kind} targets" in md and "load average" in md
     assert "| end-to-end render | 1.20 s (rounds 1.30, 1.10 s) |" in md
+    assert "| hud_ms_720p | 0.8 | 0.8..0.9 (12 %) |" in md and "its 2 rounds' medians 0.8..0.9 (12 %)" in md
 
 
 def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):

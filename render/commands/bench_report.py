@@ -65,7 +65,8 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
                                                      for p, v in pk.items()},
                       # a render and a floor per round, in phases of their own: round i's render over its floor
                       "render_over_realtime": peers.ratio(e2e["rounds_s"], [chaos_s] * len(e2e["rounds_s"])),
-                      "end_to_end_over_encode_floor": peers.ratio(e2e["rounds_s"], enc["floor_rounds_s"])},
+                      "end_to_end_over_encode_floor": peers.ratio(e2e["rounds_s"], enc["floor_rounds_s"]),
+                      "hud_ms_720p": res["hud"].get("spread")},
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING},
            "compiled": {k: v["compiled"] for k, v in res.items() if v.get("compiled")},  # kernels, by phase
            "rerun": [k for k, v in res.items() if v.get("rerun")]}
@@ -93,7 +94,7 @@ def fmt(val, spec=".3g") -> str:
 
 
 def spread_text(s: dict | None, spec=".3g") -> str:
-    """A ratio's per-round range and its width in % of the ratio; blank for a figure that is not a ratio."""
+    """A figure's per-round range and its width in % of the figure; blank for one measured in a single round."""
     return "" if s is None else f"{s['min']:{spec}}..{s['max']:{spec}} ({s['spread_pct']:.0f} %)"
 
 
@@ -206,7 +207,8 @@ def markdown(r: dict) -> str:
         ["to MP4 (wall s)", f"{mp['ours_s']:.2f} s", f"{mp['matplotlib_s']:.2f} s", with_spread(mp["vs"]["render"])],
         ["drawn, no encoding (fps)", f"{mp['ours_draw_fps']:.0f}", f"{mp['matplotlib_draw_fps']:.1f}",
          with_spread(mp["vs"]["draw"])]])
-    out += ["", f"HUD alone at {h['size']}: **{h['ms']:.2f} ms** per frame (median of {h['frames']} frames)."]
+    rounds = f"; its {len(h['rounds_ms'])} rounds' medians {spread_text(h['spread'])}" if h.get("spread") else ""
+    out += ["", f"HUD alone at {h['size']}: **{h['ms']:.2f} ms** per frame (median of {h['frames']} frames{rounds})."]
     out += ["", "## Peak memory per phase (process tree)", ""]
     out += table(["phase", "MB"], [[k + (" (includes the memory-mapped raw frames)" if k == "encode" else ""),
                                     f"{v:.0f}"] for k, v in r["peak_mem_mb"].items()])

@@ -128,8 +128,11 @@ def ratio(ours: list[float], peer: list[float] | None) -> dict | None:
     that range as % of the ratio; None when the peer did not run."""
     if not peer:
         return None
-    per = [a / b for a, b in zip(ours, peer)]
-    value = statistics.median(ours) / statistics.median(peer)
+    return spread([a / b for a, b in zip(ours, peer)], statistics.median(ours) / statistics.median(peer))
+
+
+def spread(per: list[float], value: float) -> dict:
+    """A figure and its rounds' range, that range as % of it, and how many rounds."""
     return {"value": value, "min": min(per), "max": max(per), "spread_pct": 100.0 * (max(per) - min(per)) / value,
             "rounds": len(per)}
 
