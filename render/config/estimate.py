@@ -34,9 +34,10 @@ RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
 FTLE_COST = 3.25
 # and its colours come from σ of each point's (2D)×(2D) MᵀM, squared ten times, every frame: 30 ms more than the
 # angles map's drawing of the same 381,924 points (36.5 against 6.2 ms a 720p frame, `python benchmarks/map_frame.py
-# fractal_lyapunov --seconds 0.2`, and fractal, 2-core Xeon, AVX-512, 2026-12-07), about the cost of 9 plain rigid
-# f64 RK4 steps of each point (115 M steps/s there). Counted as such, so it follows the machine's measured rate,
-# and as the cube of the matrix's side for another system.
+# fractal_lyapunov --seconds 0.2`, and fractal, 2-core Xeon, AVX-512, 2026-12-07), about the cost of 9 plain RK4
+# steps of each point (the double pendulum's, 115 M steps/s there). Counted as such, so it follows the machine's
+# measured rate, and another system's as the cube of its matrix's side in its own steps, which errs long: a
+# triple pendulum's step is itself slower.
 FTLE_SIGMA_STEPS = 9.0
 # Measured on this project's 2-core AMD EPYC machine (/tmp scripts timing System.advance, Canvas.draw and
 # the Encoder on their own, 2026-12-01) while other work kept its load average at about 4: a quiet machine
@@ -139,7 +140,8 @@ def estimate(scene, rates: dict, source: str = "", simulate: bool = False) -> Es
 def sigma_s(scene, rates: dict) -> float:
     """Seconds a frame of an FTLE map spends on σ of its points (FTLE_SIGMA_STEPS)."""
     side = (2 * registry.get(scene.system).D / 4) ** 3  # 1 for the double pendulum's 4×4
-    return scene.pendulums.count * FTLE_SIGMA_STEPS * side / steps_per_s(rates, "rigid", "f64", "rk4")
+    rate = steps_per_s(rates, scene.system, scene.integrator.precision, "rk4")  # σ is worked out in that precision
+    return scene.pendulums.count * FTLE_SIGMA_STEPS * side / rate
 
 
 def physics(scene, rates: dict) -> tuple[dict, float, int]:
