@@ -91,7 +91,7 @@ class Compose:
             lit = self.fade_tile(out, ty, tx, layer)
         else:  # the layer's bytes as they are: a copy, pixel by pixel
             for p in range(self.TILE * self.TILE):
-                y, x = ty * self.TILE + p // self.TILE, tx * self.TILE + p % self.TILE
+                y, x = self.in_tile(ty, tx, p)
                 c = self.rgb[y, x]
                 self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
                 if y < self.h and x < self.w:
@@ -103,48 +103,67 @@ class Compose:
         return lit
 
     @ti.func
+    def in_tile(self, ty, tx, k):
+        """Pixel k (row-major, mod TILE²) of tile (ty, tx), as bits: so LLVM sees that every pixel is in the same
+        tile and works out the tile's address once, not per pixel from y // TILE and x // TILE."""
+        b = ti.static(self.TILE.bit_length() - 1)
+        return (ty << b) | ((k >> b) & (self.TILE - 1)), (tx << b) | (k & (self.TILE - 1))
+
+    @ti.func
     def fade_tile(self, out: ti.template(), ty, tx, layer: ti.template()):
-        """A tile with a trail, two of its rows (16 pixels) at a time, in three loops over their pixels: the trail
-        (and the layer) are read into arrays on the stack, the bytes and the faded trail are worked out there,
-        then written back. Only the middle loop touches no field or array argument, so it is the one LLVM
-        vectorises (a store through a pointer it cannot tell apart from the others keeps a loop over fields
-        scalar). rigid_chaos's trails alone, 20 s on one thread: 1.66 ms a frame where pixel by pixel they took
-        2.34-2.36, the same bytes (`python benchmarks/draw_kernels.py rigid_chaos --seconds 20 --threads 1 --set
-        'effects=["trails"]'`, 2-core Xeon, AVX-512). The whole tile at once was as quick but slow to compile: a
-        render from an empty kernel cache (`TI_OFFLINE_CACHE_FILE_PATH=$(mktemp -d) pendulum render rigid_chaos`)
-        took 23.0 s, two rows at a time 20.3 s, pixel by pixel 19.6-19.7 s. A pixel off the trail (0) fades to
-        0: no branch, and dark pixels stay dark."""
-        P = ti.static(2 * self.TILE)  # 16 lanes: one vector of f32 at AVX-512's width
+        """A tile with a trail, two of its rows (16 pixels) at a time: the trail (and the layer) are read into
+        arrays on the stack in the fields' own order (pixel by pixel, three channels each), the bytes and the
+        faded trail are worked out there, channel by channel, then written back. Only that middle loop touches no
+        field or array argument, so it is the one LLVM vectorises (a store through a pointer it cannot tell apart
+        from the others keeps a loop over fields scalar); the loops around it have their addresses from
+        in_tile(), in bits, so the tile's address is worked out once. rigid_chaos's trails alone, 20 s on one
+        thread: 1.35-1.41 ms a frame, against 1.50-1.53 with in_tile() alone and 1.61-1.66 before both (channels
+        by row, pixels found from y // TILE and x // TILE), and 2.34 pixel by pixel; the same bytes (`python
+        benchmarks/draw_kernels.py rigid_chaos --seconds 20 --threads 1 --set 'effects=["trails"]'`, 2-core Xeon,
+        AVX-512, 2026-12-07). The whole tile at once was as quick but slow to compile: a render from an empty
+        kernel cache (`TI_OFFLINE_CACHE_FILE_PATH=$(mktemp -d) pendulum render rigid_chaos`) took 23.0 s, two
+        rows at a time 20.3 s (15.9-16.4 s on 2026-12-07, before this order and after it alike). A pixel off the
+        trail (0) fades to 0: no branch, and dark pixels stay dark."""
+        P = ti.static(2 * self.TILE)  # pixels at a time
+        N = ti.static(3 * P)  # their channels, in the fields' order (pixel-major): 48 lanes
         any_lit = 0
         for half in range(self.TILE // 2):
-            y0, x0 = ty * self.TILE + 2 * half, tx * self.TILE
-            c = ti.Matrix.zero(self.rgb.dtype, 3, P)
-            t = ti.Matrix.zero(ti.f32, 3, P)
-            for p in range(P):
-                y, x = y0 + p // self.TILE, x0 + p % self.TILE  # inside the fields: they are whole tiles
-                if ti.static(layer):
-                    c[:, p] = self.rgb[y, x]
+            c = ti.Vector.zero(self.rgb.dtype, N)
+            t = ti.Vector.zero(ti.f32, N)
+            if ti.static(layer):
+                for p in range(P):
+                    y, x = self.in_tile(ty, tx, P * half + p)  # inside the fields: whole tiles
+                    v = self.rgb[y, x]
+                    for k in ti.static(range(3)):
+                        c[3 * p + k] = v[k]
+                for p in range(P):
+                    y, x = self.in_tile(ty, tx, P * half + p)
                     self.rgb[y, x] = ti.cast(ti.Vector([0, 0, 0]), self.rgb.dtype)
-                t[:, p] = self.trail[y, x]
-            b = ti.Matrix.zero(ti.i32, 3, P)
-            lit = ti.Vector.zero(ti.i32, P)
-            for p in range(P):  # the loop LLVM vectorises
-                for k in ti.static(range(3)):
-                    if ti.static(layer):
-                        if ti.static(self.rgb.dtype == ti.u8):
-                            b[k, p] = ti.cast(c[k, p], ti.i32)
-                        else:
-                            b[k, p] = ti.cast(to_byte(c[k, p]), ti.i32)
-                    faded = ti.cast(t[k, p] * self.decay, ti.f32)
-                    b[k, p] = ti.max(b[k, p], ti.cast(to_byte(t[k, p]), ti.i32))
-                    dark = to_byte(faded) == 0
-                    lit[p] |= ti.cast(not dark, ti.i32)
-                    t[k, p] = ti.select(dark, 0.0, faded)
             for p in range(P):
-                y, x = y0 + p // self.TILE, x0 + p % self.TILE
-                self.trail[y, x] = t[:, p]
-                any_lit |= lit[p]
+                y, x = self.in_tile(ty, tx, P * half + p)
+                v = self.trail[y, x]
+                for k in ti.static(range(3)):
+                    t[3 * p + k] = v[k]
+            b = ti.Vector.zero(ti.i32, N)
+            lit = 0
+            for j in range(N):  # the loop LLVM vectorises
+                if ti.static(layer):
+                    if ti.static(self.rgb.dtype == ti.u8):
+                        b[j] = ti.cast(c[j], ti.i32)
+                    else:
+                        b[j] = ti.cast(to_byte(c[j]), ti.i32)
+                faded = ti.cast(t[j] * self.decay, ti.f32)
+                b[j] = ti.max(b[j], ti.cast(to_byte(t[j]), ti.i32))
+                dark = to_byte(faded) == 0
+                lit |= ti.cast(not dark, ti.i32)
+                t[j] = ti.select(dark, 0.0, faded)
+            for p in range(P):
+                y, x = self.in_tile(ty, tx, P * half + p)
+                self.trail[y, x] = ti.Vector([t[3 * p + k] for k in ti.static(range(3))])
+            for p in range(P):
+                y, x = self.in_tile(ty, tx, P * half + p)
                 if y < self.h and x < self.w:
                     for k in ti.static(range(3)):
-                        out[y, x, k] = ti.cast(b[k, p], ti.u8)
+                        out[y, x, k] = ti.cast(b[3 * p + k], ti.u8)
+            any_lit |= lit
         return any_lit
