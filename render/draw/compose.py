@@ -106,6 +106,7 @@ class Compose:
     def in_tile(self, ty, tx, k):
         """Pixel k (row-major, mod TILE²) of tile (ty, tx), as bits: so LLVM sees that every pixel is in the same
         tile and works out the tile's address once, not per pixel from y // TILE and x // TILE."""
+        ti.static_assert(self.TILE & (self.TILE - 1) == 0, "in_tile needs a TILE that is a power of two")
         b = ti.static(self.TILE.bit_length() - 1)
         return (ty << b) | ((k >> b) & (self.TILE - 1)), (tx << b) | (k & (self.TILE - 1))
 
