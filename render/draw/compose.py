@@ -123,7 +123,7 @@ class Compose:
         benchmarks/draw_kernels.py rigid_chaos --seconds 20 --threads 1 --set 'effects=["trails"]'`, 2-core Xeon,
         AVX-512, 2026-12-07). The whole tile at once was as quick but slow to compile: a render from an empty
         kernel cache (`TI_OFFLINE_CACHE_FILE_PATH=$(mktemp -d) pendulum render rigid_chaos`) took 23.0 s, two
-        rows at a time 20.3 s (15.9-16.4 s on 2026-12-07, before this order and after it alike). A pixel off the
+        rows at a time 20.3 s (15.7-16.4 s on 2026-12-07, before this order and after it alike). A pixel off the
         trail (0) fades to 0: no branch, and dark pixels stay dark."""
         P = ti.static(2 * self.TILE)  # pixels at a time
         N = ti.static(3 * P)  # their channels, in the fields' order (pixel-major): 48 lanes
