@@ -16,7 +16,7 @@ import taichi as ti
 from taichi.lang import kernel_impl
 from taichi.lang.ast import ast_transformer_utils
 
-from . import held_stderr, vector_width
+from . import held_stderr, launch, vector_width
 
 _current: tuple | None = None
 _generation = 0  # how many times Taichi was (re)initialised: fields of an older generation are gone
@@ -106,12 +106,13 @@ def real():
 
 
 class Launcher:
-    """Mixin: launch kernels by name so a run can report exactly which kernels it used."""
+    """Mixin: launch kernels by name so a run can report exactly which kernels it used; after its first launch a
+    kernel is launched as prepared (render/physics/launch.py), without Taichi's per-call Python."""
 
     def launch(self, name: str, *args):
         if name not in launched:
             launched.append(name)
-        return self.kernel(name)(*args)
+        return launch.launches(self).launch(name, lambda: self.kernel(name), args)
 
     def kernel(self, name: str):
         return getattr(self, name)

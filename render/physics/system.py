@@ -14,7 +14,7 @@ contract (LINKS, bob_sizes(), reach(), lengths). Only stepper.Run builds one wit
 import numpy as np
 import taichi as ti
 
-from . import crossings, dual, runtime, steps
+from . import crossings, dual, launch, runtime, steps
 from .plan import Plan
 from .recording import Recording
 from .sincos import sincos
@@ -77,8 +77,9 @@ class System(Plan, Recording, runtime.Launcher):
     def advance_by(self, substeps: int, h: float | None = None):
         """`substeps` steps of h (default: the scene's step), on the launching thread where that is little work
         (runtime.serial)."""
-        (self.advance_libm if self.libm else self.advance)(substeps, self.h if h is None else h,
-                                                           runtime.serial(self.n * substeps))
+        kernel = "advance_libm" if self.libm else "advance"
+        launch.launches(self).launch(kernel, lambda: getattr(self, kernel),
+                                  (substeps, self.h if h is None else h, runtime.serial(self.n * substeps)))
 
     # --------------------------------------------------------------- per-system parts
     @ti.func

@@ -52,7 +52,7 @@ class Voices:
 
     def record(self):
         """Call once per frame, with the simulation at that frame's time (frame 0 is t = 0)."""
-        self.sim.rows_into(self.q, self.recorded, self.picks)
+        self.sim.read_out("rows_into", self.q, self.recorded, self.picks)
         self.recorded += 1
 
     def track(self) -> tuple[int, np.ndarray]:

@@ -120,7 +120,7 @@ def record(scene, arch: str = "cpu", threads: int | None = None) -> dict:
     q = np.empty((scene.frames, sim.n, sim.D))
     warm = 0.0
     for f in run.frames(timings=timings):
-        sim.q_into(q, f)  # one launch, not to_numpy()'s new array (render/physics/recording.py)
+        sim.read_out("q_into", q, f)  # one launch, not to_numpy()'s new array (render/physics/recording.py)
         if f == 1:
             warm = timings["simulate"]
     steady = scene.frames - 2
