@@ -6,17 +6,13 @@ value times a float literal is computed in f64, so "f32" would silently be f64 a
 from __future__ import annotations
 
 import contextlib
-import functools
 import io
 import sys
-import textwrap
 import warnings
 
 import taichi as ti
-from taichi.lang import kernel_impl
-from taichi.lang.ast import ast_transformer_utils
 
-from . import held_stderr, launch, vector_width
+from . import frontend, held_stderr, launch, vector_width  # noqa: F401 (frontend: its memos, on import)
 
 _current: tuple | None = None
 _generation = 0  # how many times Taichi was (re)initialised: fields of an older generation are gone
@@ -145,49 +141,3 @@ def _size(dtype) -> int:
 
 
 warnings.filterwarnings("ignore", category=DeprecationWarning, module="taichi")
-
-
-@functools.lru_cache(maxsize=1 << 16)
-def _wrapped(text: str, width: int) -> tuple[str, ...]:
-    return tuple(textwrap.TextWrapper(width=width).wrap(text))
-
-
-class _RememberingWrapper:
-    """Taichi's compiler front end builds, for every statement of every kernel it compiles, the text of an error
-    message that is almost never shown: the source line and a ^^^ hint under it, each wrapped by a new
-    TextWrapper. That wrapping was 28 % of the time of rendering every preset small in one process (35 s of
-    127, cProfile), because each system instance compiles its kernels afresh and the same lines are wrapped
-    again each time. This wrapper gives the same lists, remembered by their text."""
-
-    def __init__(self, width: int = 70):
-        self.width = width
-
-    def wrap(self, text: str) -> list[str]:
-        return list(_wrapped(text, self.width))
-
-
-if ast_transformer_utils.TextWrapper is textwrap.TextWrapper:  # taichi 1.7.4 (pyproject.toml pins it)
-    ast_transformer_utils.TextWrapper = _RememberingWrapper
-
-
-# The same front end reads each Taichi function's source afresh every time a kernel that calls it is compiled:
-# inspect.getsourcelines tokenizes the whole function again (and getsourcefile searches sys.modules), once per
-# call site per kernel instance. A source file does not change under a running process, so each function's
-# lines are read once; the front end copies them before it changes anything.
-_getsourcelines, _getsourcefile = kernel_impl.getsourcelines, kernel_impl.getsourcefile
-
-
-@functools.lru_cache(maxsize=None)
-def _source_lines(func) -> tuple[tuple[str, ...], int]:
-    lines, first = _getsourcelines(func)
-    return tuple(lines), first
-
-
-def _remembered_lines(func):
-    lines, first = _source_lines(func)
-    return list(lines), first
-
-
-if kernel_impl.getsourcelines.__module__ == "taichi.lang._wrap_inspect":  # taichi 1.7.4, as above
-    kernel_impl.getsourcelines = _remembered_lines
-    kernel_impl.getsourcefile = functools.lru_cache(maxsize=None)(_getsourcefile)
