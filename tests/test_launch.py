@@ -102,6 +102,33 @@ def test_a_launch_under_forward_mode_goes_through_taichi():
     with ti.ad.FwdMode(loss=k.y, param=k.x, seed=[1.0, 0.0, 0.0, 0.0]):
         k.launch("square")
     assert k.y.dual.to_numpy().tolist() == [2.0, 0.0, 0.0, 0.0]  # d(x0²)/dx0 = 2 x0, the others 0
+    k.x.from_numpy(np.array([5.0, 6.0, 7.0, 8.0]))
+    k.x.dual.fill(1.0)
+    k.launch("square")  # after the block, the plain kernel again: the forward one would add 2 x to y's duals
+    k.launch("square")
+    assert k.y.to_numpy().tolist() == [25.0, 36.0, 49.0, 64.0]
+    assert k.y.dual.to_numpy().tolist() == [2.0, 0.0, 0.0, 0.0]
+
+
+@ti.kernel
+def weighted(twice: ti.template(), a: ti.types.ndarray(dtype=ti.f64, ndim=2), big: ti.u32, h: ti.f64) -> ti.f64:
+    """A kernel of no object, a template before the arguments the launch sets: sum(a) * h (doubled), and `big`
+    read back whole."""
+    out = 0.0
+    for i, j in ti.ndrange(a.shape[0], a.shape[1]):
+        out += a[i, j] * h * (2.0 if ti.static(twice) else 1.0)
+    return out + ti.cast(big >> 31, ti.f64)
+
+
+def test_a_kernel_of_no_object_with_a_template_first(taichi_calls):
+    ready = launch.Launches()
+    run = lambda *args: ready.launch("weighted", lambda: weighted, args)  # noqa: E731
+    assert run(True, np.ones((2, 3)), 1 << 31, 0.5) == 7.0  # 6 * 0.5 * 2 + 1
+    assert run(True, np.ones((4, 1)), np.uint32(5), np.float64(0.25)) == 2.0  # another shape, numpy scalars
+    assert run(True, np.full((1, 1), 3.0), 0xFFFFFFFF, 1) == 7.0  # 3 * 1 * 2 + 1
+    assert run(False, np.ones((2, 2)), 0, 1.0) == 4.0  # the other template value: Taichi's, then prepared
+    assert run(False, np.ones((2, 2)), 0, 1.0) == 4.0
+    assert taichi_calls == ["weighted", "weighted"]
 
 
 def test_a_new_runtime_is_never_launched_from_an_old_preparation():

@@ -13,13 +13,17 @@ compiled kernel and how to set each of its arguments. A later launch whose argum
 (scalars of the annotated types, C-contiguous numpy arrays of the same dtype and number of dimensions, the same
 template values) sets them straight into a launch context: the compiled kernel Taichi's mapper would pick is
 the same one, since it keys on exactly those kinds. Anything else goes through Taichi as before: a kernel whose
-arguments this does not cover (fields or objects as templates, Taichi's own ndarrays, structs), a launch under
-Taichi's autodiff (a FwdMode or a Tape), and every launch after Taichi is initialised again.
+arguments this does not cover (fields or objects as templates, Taichi's own ndarrays, structs), every launch
+after Taichi is initialised again, and a launch under Taichi's autodiff (a FwdMode or a Tape), where Taichi runs
+the kernel's forward or validating version: none is prepared then (tests/test_launch.py). The compiled kernel is
+looked up once, where Taichi looks it up in its cache at every launch by the compile settings of the moment;
+only render/physics/tangent.py changes one (force_scalarize_matrix), around a launch of its own under FwdMode.
 """
 from __future__ import annotations
 
 import numpy as np
 from taichi.lang import impl
+from taichi.lang.enums import AutodiffMode
 from taichi.lang.util import cook_dtype
 from taichi.types import ndarray_type, primitive_types
 from taichi.types.annotations import template
@@ -66,9 +70,13 @@ class Prepared:
         primal = getattr(kernel, "_primal", None)
         if primal is None:  # not a Taichi kernel: a method that launches one
             return None
-        owner = () if getattr(kernel, "_is_staticmethod", True) else (kernel._kernel_owner,)
+        bound = getattr(kernel, "_kernel_owner", None)  # a data-oriented object's kernel, bound to it
+        owner = () if bound is None or kernel._is_staticmethod else (bound,)
         full = owner + tuple(args)
-        if len(full) != len(primal.arguments) or primal.has_print or not _covered(primal.return_type):
+        rt = impl.get_runtime()
+        if len(full) != len(primal.arguments) or primal.has_print or not _covered(primal.return_type) or \
+                primal.autodiff_mode != AutodiffMode.NONE or rt.fwd_mode_manager is not None or \
+                rt.target_tape is not None:  # under autodiff Taichi launches another kernel, until it ends
             return None
         for k, (arg, v) in enumerate(zip(primal.arguments, full)):
             ann = arg.annotation
