@@ -242,8 +242,10 @@ def phase_hud(cfg, arch, tmp) -> dict:
     it, without a certificate as in benchmarks/effects.py): drawn onto a blank frame at every frame of the
     simulation, so its spread is the live one. Each of `rounds` rounds runs the whole simulation again and keeps
     the median over its frames after the first two (the first round's compile); the figure is the median of
-    the rounds', with their range. A frame's HUD is a third of a millisecond, about one wake-up of the thread
-    pool (render/physics/runtime.py), so one round's median moved 21 % between two runs of the same code."""
+    the rounds', with their range. A frame's HUD is a quarter to a third of a millisecond (0.30-0.37 ms in the
+    bench runs of 2026-12-06 and -07 before its launches were prepared, render/physics/launch.py; 0.22-0.25 after),
+    about one wake-up of the thread pool (render/physics/runtime.py), so one round's median moved 21 % between two
+    runs of the same code."""
     import taichi as ti
     from ..physics.stepper import Run
     from ..draw.hud import Hud, Info

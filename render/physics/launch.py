@@ -161,3 +161,8 @@ def launches(owner) -> Launches:
     if found is None:
         found = owner.__dict__["_launches"] = Launches()
     return found
+
+
+def call(owner, name: str, *args):
+    """owner's kernel `name` launched with `args`, as prepared after its first launch."""
+    return launches(owner).launch(name, lambda: getattr(owner, name), args)

@@ -13,7 +13,7 @@ from . import launch, runtime
 class Recording:
     def read_out(self, name: str, *args):
         """Kernel `name` (q_into, rows_into) launched as prepared (render/physics/launch.py): once a frame."""
-        return launch.launches(self).launch(name, lambda: getattr(self, name), args)
+        return launch.call(self, name, *args)
 
     @ti.kernel
     def record(self, out: ti.types.ndarray(dtype=ti.f64, ndim=3), substeps: ti.i32, h: float,

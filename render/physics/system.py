@@ -77,9 +77,8 @@ class System(Plan, Recording, runtime.Launcher):
     def advance_by(self, substeps: int, h: float | None = None):
         """`substeps` steps of h (default: the scene's step), on the launching thread where that is little work
         (runtime.serial)."""
-        kernel = "advance_libm" if self.libm else "advance"
-        launch.launches(self).launch(kernel, lambda: getattr(self, kernel),
-                                  (substeps, self.h if h is None else h, runtime.serial(self.n * substeps)))
+        launch.call(self, "advance_libm" if self.libm else "advance", substeps, self.h if h is None else h,
+                    runtime.serial(self.n * substeps))
 
     # --------------------------------------------------------------- per-system parts
     @ti.func
