@@ -154,6 +154,39 @@ def test_a_still_fan_sings_its_pitch_in_unison_and_fades_at_both_ends():
     assert rate == 7 * 6858 and len(odd) == 30 * 6858
 
 
+def test_the_track_made_as_the_frames_come_is_the_track_made_at_once(monkeypatch):
+    """A render feeds Track a frame at a time and makes frames in chunks as they come (render/video/audio.py): every
+    grouping of frames and every chunk size gives the same samples to the bit as a whole-array reference written
+    here from the same formulas (pitch, glide, phase at each frame start as a cumulative sum)."""
+    rng = np.random.default_rng(3)
+    angles = np.cumsum(rng.normal(0, 0.2, (61, 5, 2)), axis=0) + 2.0
+    fps, per = 30, 1600
+    hz = audio.pitch(angles)
+    glide = np.diff(hz, axis=0, append=hz[-1:])
+    turn = 2 * np.pi / fps
+    start = np.zeros_like(hz)
+    start[1:] = np.cumsum((hz + glide / 2)[:-1] * turn, axis=0) % (2 * np.pi)
+    w = np.arange(per, dtype=np.float32) / np.float32(per)
+    ph = (hz * turn).astype(np.float32)[..., None] * w
+    ph += (glide * turn / 2).astype(np.float32)[..., None] * (w * w)
+    ph += start[..., None].astype(np.float32)
+    x = np.sin(ph).sum(axis=1).transpose(0, 2, 1).reshape(-1, 2)
+    reference = audio.quantise(audio.fade(audio.level(x, fps * per), fps * per))
+    for chunk in (1, 2, 7, 100):
+        monkeypatch.setattr(audio, "CHUNK_FRAMES", chunk)
+        track, f = audio.Track(len(angles), 5, fps), 0
+        for n in (1, 3, 2, 10, 45):  # frames as they come, in groups of any size
+            track.add(angles[f:f + n])
+            f += n
+        rate, samples = track.finish()
+        assert rate == fps * per and np.array_equal(samples, reference), chunk
+        assert np.array_equal(audio.synthesise(angles, fps)[1], reference)
+    with pytest.raises(ValueError, match="the angles of 60 frames, not 61"):
+        short = audio.Track(len(angles), 5, fps)
+        short.add(angles[:60])
+        short.finish()
+
+
 def test_audio_is_refused_where_there_are_no_fan_angles(tmp_path):
     res = run_cli("render", "elastic_fan", "--out", tmp_path / "o", "--set",
                   'effects=["springs", "bobs", "audio"]')

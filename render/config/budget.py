@@ -192,7 +192,7 @@ def memory(scene, system, simulate: bool) -> tuple[int, str, str]:
     gif = gif_frames(scene) * gif_pixels(scene) * GIF_BUFFER_BYTES_PER_PIXEL if "gif" in v.formats else 0
     # A comparison keeps every variant's state at every frame until its panels are drawn (render/draw/split.py).
     kept = len(scene.compare[0][1]) * scene.frames * n * d * 8 if scene.compare else 0
-    sound = audio.peak_bytes(scene) if audio.heard(scene) else 0  # made whole once the frames are done
+    sound = audio.peak_bytes(scene) if audio.heard(scene) else 0  # made as the frames come, levelled at the end
     terms = {"pendulums.count": state, "video.width, video.height": canvas + queued,
              "video.gif_width, video.duration": gif, "pendulums.count, video.duration": kept,
              "video.duration": sound}

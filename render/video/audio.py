@@ -21,7 +21,12 @@ LOW_HZ, OCTAVES = 220.0, 2.0  # a hanging link sings A3, an upright one A5
 LEVEL_S = 0.25  # the loudness is evened out over blocks this long (see level)
 FADE_S = 0.02  # raised-cosine fades at both ends: no click where the track starts and stops
 PEAK = 10 ** (-1 / 20)  # -1 dBFS: headroom for the AAC encoder's overshoot
-CHUNK = 1 << 14  # samples made at once: the work arrays stay at VOICES x 2 x CHUNK floats (8 MB)
+CHUNK = 1 << 14  # samples levelled at once (level)
+# Frames made at once (Track): their work arrays, VOICES x 2 x 1600 floats at 60 fps (0.8 MB), stay in the cache.
+# rigid_chaos's 1200 frames took synthesise() 0.29-0.30 s in chunks of 20 frames and new arrays, 0.23 s in chunks of
+# 2 into the same arrays; 4 took 0.27, 8 0.29 (a script timing synthesise on 64 voices, 2-core Xeon, AVX-512,
+# 2026-12-07). The samples are the same to the bit at any chunk size: each is made by the same elementwise steps.
+CHUNK_FRAMES = 2
 
 
 def heard(scene) -> bool:
@@ -31,33 +36,35 @@ def heard(scene) -> bool:
 
 
 def peak_bytes(scene) -> int:
-    """What making the track holds at most (render/config/budget.py counts it): the heard pendulums' coordinates
-    at every frame (float64), their first two angles turned into pitches and phases (about 5 float64 copies
-    more), the work arrays of a chunk, and 16 bytes a stereo sample (float32 samples, a channel's squares, then
-    int16). tracemalloc: 32 MB for rigid_chaos."""
+    """What making the track holds at most (render/config/budget.py counts it): the float32 samples, 8 bytes a
+    stereo sample, held from the first frame, and while level() evens out a channel its squares in float32 and
+    again in float64, 12 bytes more (4 to spare for numpy's smaller temporaries); a chunk's work arrays, two float32
+    ones of its samples for every voice; its pitches and phases. tracemalloc: 22.0 MB for rigid_chaos (a script
+    feeding Voices 1200 frames of 64 voices, then track()), against 24.7 MB here."""
     voices = min(VOICES, scene.pendulums.count)
-    samples = scene.frames * -(-AUDIO_RATE // scene.video.fps)
-    record = scene.frames * voices * 8 * (registry.get(scene.system).D + 2 * 5)
-    return record + 2 * voices * 2 * CHUNK * 4 + 16 * samples
+    per = -(-AUDIO_RATE // scene.video.fps)
+    work = (CHUNK_FRAMES + 1) * voices * 8 * (registry.get(scene.system).D + 2 * 5)
+    return work + 2 * CHUNK_FRAMES * voices * 2 * per * 4 + 24 * scene.frames * per
 
 
 class Voices:
-    """The heard pendulums' first two angles, recorded frame by frame as a render steps; then the track."""
+    """The heard pendulums' first two angles, read frame by frame as a render steps and made into the track as
+    they come (Track); then the track."""
 
     def __init__(self, sim, fps: int, frames: int):
-        self.sim, self.fps = sim, fps
+        self.sim = sim
         self.picks = np.unique(np.linspace(0, sim.n - 1, min(VOICES, sim.n)).round().astype(np.int64))
-        self.q = np.empty((frames, len(self.picks), sim.D))  # the heard pendulums' coordinates, frame by frame
-        self.recorded = 0
+        self.q = np.empty((1, len(self.picks), sim.D))  # the heard pendulums' coordinates at this frame
+        self.made = Track(frames, len(self.picks), fps)
 
     def record(self):
         """Call once per frame, with the simulation at that frame's time (frame 0 is t = 0)."""
-        self.sim.read_out("rows_into", self.q, self.recorded, self.picks)
-        self.recorded += 1
+        self.sim.read_out("rows_into", self.q, 0, self.picks)
+        self.made.add(self.q[:, :, :2])
 
     def track(self) -> tuple[int, np.ndarray]:
         """(rate, int16 samples of shape (S, 2)): what Encoder.close muxes."""
-        return synthesise(self.q[:self.recorded, :, :2], self.fps)
+        return self.made.finish()
 
     def summary(self) -> dict:
         """What metadata.json says of the track."""
@@ -74,33 +81,70 @@ def pitch(theta: np.ndarray) -> np.ndarray:
 
 
 def synthesise(angles: np.ndarray, fps: int, rate: int = AUDIO_RATE) -> tuple[int, np.ndarray]:
-    """(rate, int16 samples (S, 2)) from angles (frames, voices, 2). Frame f is shown from f/fps to (f+1)/fps
-    and the pitch glides linearly from its value to the next frame's (the last holds): each voice's phase,
-    the integral of its pitch, is then exact in closed form, with no voice ever jumping.
+    """(rate, int16 samples (S, 2)) from angles (frames, voices, 2): a Track fed every frame at once."""
+    track = Track(len(angles), angles.shape[1], fps, rate)
+    track.add(angles)
+    return track.finish()
 
-    Every frame gets the same whole number of samples, so the work is whole arrays (frames, voices, 2,
-    samples) with no gathering: the rate is the next multiple of fps at or above `rate` (48000 itself at
-    the fps that divide it: 60, 50, 30, 25, 24 ...), and ffmpeg resamples the others to `rate`. Float32
-    (half the memory) within a frame, where the phase grows by at most 2π·880/fps (92 rad at 60 fps: an
-    error below 1e-5 rad); float64 for the phases at frame starts, which sum the whole track."""
-    frames, voices = angles.shape[:2]
-    per = -(-rate // fps)
-    hz = pitch(angles)
-    glide = np.diff(hz, axis=0, append=hz[-1:])  # to the next frame's pitch
-    turn = 2 * np.pi / fps  # radians per Hz over one frame
-    start = np.zeros_like(hz)  # every voice starts at phase 0: a fan together starts in unison
-    start[1:] = np.cumsum((hz + glide / 2)[:-1] * turn, axis=0) % (2 * np.pi)
-    w = np.arange(per, dtype=np.float32) / np.float32(per)  # a sample's place within its frame
-    lin, quad = (hz * turn).astype(np.float32), (glide * turn / 2).astype(np.float32)
-    x = np.empty((frames * per, 2), np.float32)  # level() sets the scale, not the number of voices
-    chunk = max(1, CHUNK // per)  # frames
-    for a in range(0, frames, chunk):
-        b = slice(a, a + chunk)
-        ph = lin[b, ..., None] * w
-        ph += quad[b, ..., None] * (w * w)
-        ph += start[b, ..., None].astype(np.float32)
-        x.reshape(frames, per, 2)[b] = np.sin(ph, out=ph).sum(axis=1).transpose(0, 2, 1)
-    return per * fps, quantise(fade(level(x, per * fps), per * fps))
+
+class Track:
+    """The track of `frames` frames, made as their angles come (add()), so that after the last frame only its end
+    and the levelling are left (finish()). In a render that is the part after the last frame, when nothing else
+    of ours runs and the MP4's track waits for it: rigid_chaos's whole synthesis there took 0.35 s, its mux 0.46
+    s after it (timestamps around Encoder.close, 2-core Xeon, AVX-512, 2026-12-07).
+
+    Frame f is shown from f/fps to (f+1)/fps and the pitch glides linearly from its value to the next frame's
+    (the last holds): each voice's phase, the integral of its pitch, is then exact in closed form, with no voice
+    ever jumping. So a frame is made once the next one's angles are in. Every frame gets the same whole number
+    of samples, so the work is whole arrays (frames, voices, 2, samples) with no gathering: the rate is the next
+    multiple of fps at or above `rate` (48000 itself at the fps that divide it: 60, 50, 30, 25, 24 ...), and
+    ffmpeg resamples the others to `rate`. Float32 (half the memory) within a frame, where the phase grows by at
+    most 2π·880/fps (92 rad at 60 fps: an error below 1e-5 rad); float64 for the phases at frame starts, which
+    sum the whole track, frame after frame as a cumulative sum would.
+    """
+
+    def __init__(self, frames: int, voices: int, fps: int, rate: int = AUDIO_RATE):
+        self.frames, self.per = frames, -(-rate // fps)
+        self.rate, self.turn = self.per * fps, 2 * np.pi / fps  # radians per Hz over one frame
+        self.x = np.empty((frames * self.per, 2), np.float32)  # level() sets the scale, not the number of voices
+        self.w = np.arange(self.per, dtype=np.float32) / np.float32(self.per)  # a sample's place within its frame
+        self.ww = self.w * self.w
+        self.work = np.empty((2, CHUNK_FRAMES, voices, 2, self.per), np.float32)
+        self.phase = np.zeros((voices, 2))  # at the next frame's start, unwrapped: every voice starts at 0, so
+        self.hz = np.empty((0, voices, 2))  # a fan together starts in unison; pitches of frames not yet made
+        self.made = 0
+
+    def add(self, angles: np.ndarray):
+        """The angles (n, voices, 2) of the next n frames; makes every frame whose next one is in."""
+        self.hz = np.concatenate([self.hz, pitch(angles)])
+        while len(self.hz) > CHUNK_FRAMES:
+            self._make(CHUNK_FRAMES, self.hz[1:CHUNK_FRAMES + 1])
+
+    def finish(self) -> tuple[int, np.ndarray]:
+        """(rate, int16 samples (S, 2)) once every frame's angles are in: the last frames, then the levelling."""
+        if self.made + len(self.hz) != self.frames:
+            raise ValueError(f"the track has the angles of {self.made + len(self.hz)} frames, not {self.frames}")
+        while len(self.hz):
+            n = min(CHUNK_FRAMES, len(self.hz))
+            self._make(n, np.concatenate([self.hz[1:n + 1], self.hz[-1:]])[:n])  # the last holds its pitch
+        return self.rate, quantise(fade(level(self.x, self.rate), self.rate))
+
+    def _make(self, n: int, after: np.ndarray):
+        """The samples of the first n frames waiting, whose next frames' pitches are `after`."""
+        hz, self.hz = self.hz[:n], self.hz[n:]
+        glide = after - hz  # to the next frame's pitch
+        start = np.empty_like(hz)
+        for k in range(n):
+            start[k] = self.phase % (2 * np.pi)
+            self.phase = self.phase + (hz[k] + glide[k] / 2) * self.turn
+        ph, quad = self.work[0, :n], self.work[1, :n]
+        np.multiply((hz * self.turn).astype(np.float32)[..., None], self.w, out=ph)
+        np.multiply((glide * self.turn / 2).astype(np.float32)[..., None], self.ww, out=quad)
+        ph += quad
+        ph += start[..., None].astype(np.float32)
+        a = self.made * self.per
+        self.x[a:a + n * self.per].reshape(n, self.per, 2)[:] = np.sin(ph, out=ph).sum(axis=1).transpose(0, 2, 1)
+        self.made += n
 
 
 def level(x: np.ndarray, rate: int) -> np.ndarray:
