@@ -96,3 +96,26 @@ def test_a_layer_of_bytes_gives_the_frames_a_layer_of_floats_gives(name, monkeyp
         runs.append(frames)
     bad = [f for f, (a, b) in enumerate(zip(*runs)) if a != b]
     assert len(runs[1]) == scene.frames and not bad, f"{len(bad)} frames differ, the first {bad[:1]}"
+
+
+@pytest.mark.parametrize("name, byte_layer", [("rigid_chaos", True), ("rigid_chaos", False), ("triple_chaos", True),
+                                              ("elastic_fan", True)])
+def test_rows_written_as_words_give_the_bytes_written_one_by_one(name, byte_layer, monkeypatch):
+    """Where the width is whole tiles the frame pass writes a tile's row as words (render/draw/compose.py's
+    put_row): the same frames as byte by byte, drawn over the last frame (tiles that go dark are zeroed as words
+    too), with a partial row of tiles at the bottom (180 = 22.5 tiles), trails, the HUD, and a layer of bytes or
+    of floats. A frame the words cannot alias is refused, not drawn into a copy."""
+    monkeypatch.setattr(canvas_module, "BYTE_LAYER", byte_layer)
+    scene = load(name, ["video.width=320", "video.height=180", "video.fps=30", "video.duration=6"])
+    runs = []
+    for words in (False, True):
+        run = Run(scene)
+        canvas = Canvas(scene, run.sim)
+        assert canvas.word_rows  # 320 = 40 tiles
+        canvas.word_rows = words  # before the first draw compiles draw_frame for this canvas
+        frame = canvas.new_frame()
+        runs.append([canvas.draw(frame).tobytes() for _ in run.frames()])
+    bad = [f for f, (a, b) in enumerate(zip(*runs)) if a != b]
+    assert len(runs[1]) == scene.frames and not bad, f"{len(bad)} frames differ, the first {bad[:1]}"
+    with pytest.raises(ValueError, match="C-contiguous"):
+        canvas.draw(np.zeros((180, 640, 3), np.uint8)[:, ::2])

@@ -61,6 +61,10 @@ class Canvas(Raster, Compose, runtime.Launcher):
         self.one_band = self.banded and self.bands == 1  # its loops on the launching thread
         self.band_rows = -(-self.ty // self.bands) * TILE  # whole tiles: no tile's mark has two writers
         self.slots = self.bands * BAND_SLOTS if self.banded else self.n
+        # the frame pass writes a tile's row as words where the width is whole tiles (compose.py's put_row); not on
+        # CUDA, where Taichi copies each array argument back from the device, so two views of one frame would clash
+        self.word_rows = self.banded and not self.glowing and self.w % TILE == 0
+        self.no_words = np.zeros((1, 1), np.uint32)  # draw_frame's `words` where it writes bytes
         self.few = runtime.serial(self.n * len(sim.LINKS))  # a loop over the points runs serially (SERIAL_WORK)
         # this frame's rods, coils and bobs; zero outside the tiles marked in `drawn` (BYTE_LAYER)
         self.rgb = runtime.field("canvas.frame", ti.u8 if BYTE_LAYER and self.banded and not self.glowing else light,
@@ -155,13 +159,21 @@ class Canvas(Raster, Compose, runtime.Launcher):
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0), self.skipped)
             self.skipped = 0
-        self.launch(self.frame_kernel, out)
+        self.launch(self.frame_kernel, out, self.words(out))
         if self.section is not None:
             self.section.draw(out, self.frame_no == 0)
         if self.hud is not None:
             self.hud.draw(out, self.frame_no / self.fps if t is None else t)
         self.frame_no += 1
         return out
+
+    def words(self, out: np.ndarray) -> np.ndarray:
+        """`out`'s rows as uint32, the same memory, for draw_frame (word_rows); else a stand-in it never reads."""
+        if not self.word_rows:
+            return self.no_words
+        if not out.flags.c_contiguous:  # a reshape would copy, and the frame would never see the words
+            raise ValueError("Canvas.draw: out must be a C-contiguous H×W×3 uint8 array")
+        return out.reshape(self.h, -1).view(np.uint32)
 
     # ------------------------------------------------------------ kernels
     @ti.func
@@ -217,7 +229,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
             self.last[i] = self.pos[i, self.tip]
 
     @ti.kernel
-    def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3)):
+    def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), words: ti.types.ndarray(dtype=ti.u32, ndim=2)):
         """This frame's rods, coils and bobs, as the scene calls for them, composed with the trails into `out`
         (render/draw/compose.py). On the CPU it is one parallel loop: each band's thread draws every primitive
         into its rows, then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms
@@ -233,11 +245,11 @@ class Canvas(Raster, Compose, runtime.Launcher):
                     self.pivot(w[2], w[3])
                     for ty in range(w[2] // TILE, ti.min(-(-w[3] // TILE), self.ty)):
                         for tx in range(self.tx):
-                            self.compose(out, ty, tx)
+                            self.compose(out, words, ty, tx)
         if ti.static(not self.banded):
             self.pivot(0, self.h)
             for ty, tx in ti.ndrange(self.ty, self.tx):
-                self.compose(out, ty, tx)
+                self.compose(out, words, ty, tx)
 
     @ti.func
     def primitives(self, i, y0, y1):
