@@ -37,12 +37,12 @@ def render(scene, out, threads=1):
             self.queue.put = lambda x, *b, **c: (piped.append(("end", writing[0]) if x is None else x.shape),
                                                  put(x, *b, **c))
 
-    def write(self, frame, gif_frame=None):
+    def write(self, frame, gif_frame=None, lit=None):
         if gif_frame is not None:
             small[self.written] = gif_frame.copy()
         writing[0] = self.written
         try:
-            return real_write(self, frame, gif_frame)
+            return real_write(self, frame, gif_frame, lit)
         finally:
             writing[0] = None
 

@@ -102,3 +102,34 @@ def test_a_render_drawing_over_one_frame_encodes_what_new_frames_would(tmp_path,
         pipeline.render(scene, out, frame_hook=hook)
         mp4.append((scene.out_dir(out) / "classic.mp4").read_bytes())
     assert mp4[0] == mp4[1]
+
+
+@pytest.mark.parametrize("name, w, h", [("rigid_chaos", 320, 180), ("rainbow_1000", 320, 180),
+                                        ("elastic_fan", 324, 182), ("triple_chaos", 640, 360), ("classic", 320, 180)])
+def test_the_tiles_a_canvas_calls_dark_are_black_and_are_not_read(name, w, h):
+    """A fan's Source says which tiles of the frame it drew last may hold anything but black (render/draw/compose.py's
+    lit_tiles: what the frame pass composed, and the HUD's boxes), and the MP4's conversion reads no other: every
+    tile it calls dark is black, and the yuv420p frames are those of reading every pixel. Over 4 s of chaos
+    (trails fading out tile by tile, the HUD's clock), drawn over one frame as a render does, under max and glow
+    compositing, at a width of whole tiles (word rows) and one that is not (324)."""
+    from render.config.scene import load
+    from render.video import pipeline
+    scene = load(name, [f"video.width={w}", f"video.height={h}", "video.fps=30", "video.duration=4"])
+    src, frame = pipeline.Source(scene), None
+    for _ in range(scene.frames):
+        frame = src.next_frame(frame)
+        tiles, side = src.lit_tiles()
+        dark = np.repeat(np.repeat(tiles == 0, side, axis=0), side, axis=1)[:h, :w]
+        assert dark.any() and not frame[dark].any()
+        np.testing.assert_array_equal(yuv.convert(frame, (tiles, side)), yuv.convert(frame))
+    with pytest.raises(ValueError, match="do not tile"):
+        yuv.convert(frame, (tiles[1:], side))
+
+
+def test_a_frame_something_else_draws_into_has_no_dark_tiles():
+    """A Poincaré section draws its half of the frame after the frame pass: its Source knows no dark tiles."""
+    from render.config.scene import load
+    from render.video import pipeline
+    src = pipeline.Source(load("poincare_shell", ["video.width=320", "video.height=180", "video.duration=0.1"]))
+    src.next_frame()
+    assert src.canvas.section is not None and src.lit_tiles() is None

@@ -159,7 +159,7 @@ class Canvas(Raster, Compose, runtime.Launcher):
         if self.trails:
             self.launch("stamp_trails", int(self.frame_no == 0), self.skipped)
             self.skipped = 0
-        self.launch(self.frame_kernel, out, self.words(out))
+        self.launch(self.frame_kernel, out, self.words(out), self.shown)
         if self.section is not None:
             self.section.draw(out, self.frame_no == 0)
         if self.hud is not None:
@@ -229,7 +229,8 @@ class Canvas(Raster, Compose, runtime.Launcher):
             self.last[i] = self.pos[i, self.tip]
 
     @ti.kernel
-    def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), words: ti.types.ndarray(dtype=ti.u32, ndim=2)):
+    def draw_frame(self, out: ti.types.ndarray(dtype=ti.u8, ndim=3), words: ti.types.ndarray(dtype=ti.u32, ndim=2),
+                   shown: ti.types.ndarray(dtype=ti.i32, ndim=2)):
         """This frame's rods, coils and bobs, as the scene calls for them, composed with the trails into `out`
         (render/draw/compose.py). On the CPU it is one parallel loop: each band's thread draws every primitive
         into its rows, then composes its rows. A parallel loop is a wake-up of the thread pool, about 0.29 ms
@@ -245,11 +246,11 @@ class Canvas(Raster, Compose, runtime.Launcher):
                     self.pivot(w[2], w[3])
                     for ty in range(w[2] // TILE, ti.min(-(-w[3] // TILE), self.ty)):
                         for tx in range(self.tx):
-                            self.compose(out, words, ty, tx)
+                            self.compose(out, words, shown, ty, tx)
         if ti.static(not self.banded):
             self.pivot(0, self.h)
             for ty, tx in ti.ndrange(self.ty, self.tx):
-                self.compose(out, words, ty, tx)
+                self.compose(out, words, shown, ty, tx)
 
     @ti.func
     def primitives(self, i, y0, y1):

@@ -32,8 +32,15 @@ class Compose:
             over[max(y0, 0) // t:min(y1, h - 1) // t + 1, max(x0, 0) // t:min(x1, w - 1) // t + 1] = 1
         self.hud_tiles = runtime.field("canvas.hud_tiles", ti.i32, (self.ty, self.tx))
         self.hud_tiles.from_numpy(over)
-        self.shown = runtime.field("canvas.frame_shown", ti.i32, (self.ty, self.tx))  # may hold light
-        self.shown.from_numpy(over)
+        # the tiles that may hold light: draw_frame's argument, which the frame pass rewrites, and what the MP4's
+        # conversion reads to skip the dark ones (lit_tiles(), render/video/yuv.py)
+        self.shown = over
+
+    def lit_tiles(self) -> tuple[np.ndarray, int] | None:
+        """(tiles, side): which side×side tiles (row-major) of the frame drawn last may hold anything but black;
+        the rest are black to the byte. None where something draws into the frame after the frame pass besides
+        the HUD (whose boxes count as lit): a Poincaré section's half."""
+        return None if self.section is not None else (self.shown, self.TILE)
 
     def frame_for(self, out: np.ndarray | None) -> np.ndarray:
         """The array a draw composes into: `out`, cleared unless it is the frame drawn last; a new zeroed one
@@ -46,7 +53,7 @@ class Compose:
         return out
 
     @ti.func
-    def compose(self, out: ti.template(), words: ti.template(), ty, tx):
+    def compose(self, out: ti.template(), words: ti.template(), shown: ti.template(), ty, tx):
         """max(layer, trail) to bytes in a tile something touched; zero in a tile that held light in the kept
         frame and is dark now; the rest as it is.
 
@@ -65,11 +72,11 @@ class Compose:
                 self.tile(out, words, ty, tx, True, False)
         elif drawn:
             self.tile(out, words, ty, tx, True, False)
-        if not (drawn or lit) and self.shown[ty, tx]:
+        if not (drawn or lit) and shown[ty, tx]:
             black = ti.Vector.zero(ti.i32, 3 * self.TILE)
             for r in range(self.TILE):
                 self.put_row(out, words, ty, tx, r, black, 0)
-        self.shown[ty, tx] = drawn | lit | self.hud_tiles[ty, tx]
+        shown[ty, tx] = drawn | lit | self.hud_tiles[ty, tx]
         self.drawn[ty, tx] = 0
 
     @ti.func

@@ -159,10 +159,11 @@ class Encoder:
         still keeps whatever the frame holds at close()."""
         return any(not t.planar and t.small is None for t in self.targets)
 
-    def write(self, frame: np.ndarray, small: np.ndarray | None = None):
+    def write(self, frame: np.ndarray, small: np.ndarray | None = None, lit: tuple[np.ndarray, int] | None = None):
         """Queue one H×W×3 uint8 frame; blocks only while an encoder is QUEUE_FRAMES behind. `small` is the
         GIF's frame for it, drawn at the GIF's size (render/video/gif.py), where the GIF keeps this frame;
         without it the GIF gets `frame` area-averaged to its size. No frame larger reaches the GIF's pipe.
+        `lit`: the tiles of `frame` that may hold anything but black, if its canvas knows (render/video/yuv.py).
 
         The frames are shared, not copied: do not modify them after writing them.
         """
@@ -173,7 +174,7 @@ class Encoder:
                 except subprocess.TimeoutExpired:
                     pass
                 raise self._failure("stopped", t.error)
-        yuv_frame = self.yuv.convert(frame) if any(t.planar for t in self.targets) else None
+        yuv_frame = self.yuv.convert(frame, lit) if any(t.planar for t in self.targets) else None
         for t in self.targets:
             n = 1 if t.repeats is None else t.repeats[self.written]
             if n and t.small is not None:

@@ -95,6 +95,12 @@ class Source:
         self.timings["draw"] += time.perf_counter() - t
         return frame
 
+    def lit_tiles(self) -> tuple[np.ndarray, int] | None:
+        """Which tiles of the frame drawn last may hold anything but black, where its canvas knows
+        (render/draw/compose.py); the MP4's conversion reads no other (render/video/yuv.py). None for a map."""
+        lit = getattr(self.canvas, "lit_tiles", None)
+        return lit() if lit is not None else None
+
     def skip_frame(self):
         """On to the next frame without drawing it (the watchdog still checks it): for a render whose outputs
         are all drawn by canvases of their own (a GIF alone)."""
@@ -197,7 +203,9 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                         frame_hook(f, frame)
                     gif_frame = small.frame(f, frame) if small else None
                     t = time.perf_counter()
-                    enc.write(frame, gif_frame)  # blocks only when the encoder is behind
+                    # the tiles it may have lit, from a fan's Source (not a comparison's or a cluster's)
+                    lit = src.lit_tiles() if drawn and isinstance(src, Source) else None
+                    enc.write(frame, gif_frame, lit)  # blocks only when the encoder is behind
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()
