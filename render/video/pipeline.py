@@ -203,8 +203,9 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                         frame_hook(f, frame)
                     gif_frame = small.frame(f, frame) if small else None
                     t = time.perf_counter()
-                    # the tiles it may have lit, from a fan's Source (not a comparison's or a cluster's)
-                    lit = src.lit_tiles() if drawn and isinstance(src, Source) else None
+                    # the tiles it may have lit, from a fan's Source (not a comparison's or a cluster's), where
+                    # no hook had the frame, which could have drawn on it
+                    lit = src.lit_tiles() if drawn and frame_hook is None and isinstance(src, Source) else None
                     enc.write(frame, gif_frame, lit)  # blocks only when the encoder is behind
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
