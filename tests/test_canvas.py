@@ -117,5 +117,6 @@ def test_rows_written_as_words_give_the_bytes_written_one_by_one(name, byte_laye
         runs.append([canvas.draw(frame).tobytes() for _ in run.frames()])
     bad = [f for f, (a, b) in enumerate(zip(*runs)) if a != b]
     assert len(runs[1]) == scene.frames and not bad, f"{len(bad)} frames differ, the first {bad[:1]}"
-    with pytest.raises(ValueError, match="C-contiguous"):
-        canvas.draw(np.zeros((180, 640, 3), np.uint8)[:, ::2])
+    for wrong in (np.zeros((180, 640, 3), np.uint8)[:, ::2], np.zeros((90, 640, 3), np.uint8)):
+        with pytest.raises(ValueError, match="C-contiguous 180x320x3 uint8"):
+            canvas.draw(wrong)

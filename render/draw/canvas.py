@@ -171,8 +171,9 @@ class Canvas(Raster, Compose, runtime.Launcher):
         """`out`'s rows as uint32, the same memory, for draw_frame (word_rows); else a stand-in it never reads."""
         if not self.word_rows:
             return self.no_words
-        if not out.flags.c_contiguous:  # a reshape would copy, and the frame would never see the words
-            raise ValueError("Canvas.draw: out must be a C-contiguous H×W×3 uint8 array")
+        # a reshape would copy, and the frame would never see the words; a view of other rows would misplace them
+        if not out.flags.c_contiguous or out.shape != (self.h, self.w, 3) or out.dtype != np.uint8:
+            raise ValueError(f"Canvas.draw: out must be a C-contiguous {self.h}x{self.w}x3 uint8 array")
         return out.reshape(self.h, -1).view(np.uint32)
 
     # ------------------------------------------------------------ kernels
