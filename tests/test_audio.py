@@ -180,6 +180,8 @@ def test_the_track_made_as_the_frames_come_is_the_track_made_at_once(monkeypatch
             f += n
         rate, samples = track.finish()
         assert rate == fps * per and np.array_equal(samples, reference), chunk
+        with pytest.raises(ValueError, match="finished"):
+            track.finish()
         assert np.array_equal(audio.synthesise(angles, fps)[1], reference)
     with pytest.raises(ValueError, match="the angles of 60 frames, not 61"):
         short = audio.Track(len(angles), 5, fps)

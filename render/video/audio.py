@@ -109,10 +109,11 @@ class Track:
         self.x = np.empty((frames * self.per, 2), np.float32)  # level() sets the scale, not the number of voices
         self.w = np.arange(self.per, dtype=np.float32) / np.float32(self.per)  # a sample's place within its frame
         self.ww = self.w * self.w
-        self.work = np.empty((2, CHUNK_FRAMES, voices, 2, self.per), np.float32)
-        self.phase = np.zeros((voices, 2))  # at the next frame's start, unwrapped: every voice starts at 0, so
-        self.hz = np.empty((0, voices, 2))  # a fan together starts in unison; pitches of frames not yet made
-        self.made = 0
+        self.work = np.empty((2, CHUNK_FRAMES, voices, 2, self.per), np.float32)  # a chunk's phases and glides
+        # the phase at the next frame's start, unwrapped; every voice starts at 0: a fan together starts in unison
+        self.phase = np.zeros((voices, 2))
+        self.hz = np.empty((0, voices, 2))  # the pitches of the frames added and not yet made
+        self.made = 0  # frames made
 
     def add(self, angles: np.ndarray):
         """The angles (n, voices, 2) of the next n frames; makes every frame whose next one is in."""
@@ -122,6 +123,8 @@ class Track:
 
     def finish(self) -> tuple[int, np.ndarray]:
         """(rate, int16 samples (S, 2)) once every frame's angles are in: the last frames, then the levelling."""
+        if self.made == self.frames > 0:
+            raise ValueError("the track is finished: its samples are levelled once")
         if self.made + len(self.hz) != self.frames:
             raise ValueError(f"the track has the angles of {self.made + len(self.hz)} frames, not {self.frames}")
         while len(self.hz):
