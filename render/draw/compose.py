@@ -13,7 +13,7 @@ frame and is not composed now: those composed then, and the HUD's boxes, which i
 frame. Any other array is cleared first. tests/test_canvas.py holds both to the bytes of a new frame.
 
 Compose is a mixin of the Canvas: it reads the canvas's size, tiles (TILE, ty, tx), layers (rgb, drawn, and
-with trails trail, lit, decay), compositing (glowing, glow) and HUD.
+with trails trail, lit, decay), compositing (glowing, glow), HUD, and whether it writes words (word_rows).
 """
 import numpy as np
 import taichi as ti

@@ -23,9 +23,10 @@ FADE_S = 0.02  # raised-cosine fades at both ends: no click where the track star
 PEAK = 10 ** (-1 / 20)  # -1 dBFS: headroom for the AAC encoder's overshoot
 CHUNK = 1 << 14  # samples levelled at once (level)
 # Frames made at once (Track): their work arrays, VOICES x 2 x 1600 floats at 60 fps (0.8 MB), stay in the cache.
-# rigid_chaos's 1200 frames took synthesise() 0.29-0.30 s in chunks of 20 frames and new arrays, 0.23 s in chunks of
-# 2 into the same arrays; 4 took 0.27, 8 0.29 (a script timing synthesise on 64 voices, 2-core Xeon, AVX-512,
-# 2026-12-07). The samples are the same to the bit at any chunk size: each is made by the same elementwise steps.
+# rigid_chaos's own 64 voices over its 1200 frames (pipeline.record's angles), synthesise() in 6 rounds: 0.33-0.37 s
+# in chunks of 20 frames into new arrays (before), 0.28-0.34 s in chunks of 2 into the same arrays, 0.31-0.40 in
+# chunks of 4, 0.34-0.40 in chunks of 8 (a script, 2-core Xeon, AVX-512, 2026-12-07). The samples are the same to
+# the bit at any chunk size: each is made by the same elementwise steps.
 CHUNK_FRAMES = 2
 
 
