@@ -3,11 +3,11 @@
     .venv/bin/python benchmarks/cpu_budget.py [--rounds 3] [--seconds 20]
 
 Runs what `pendulum bench` times for end_to_end_over_encode_floor, rigid_chaos's render and its encode floor
-(render/commands/bench.py's phase_encode and timed_render, after a one-frame warm-up render), alternating, once
-a round. For each it prints the wall time, this process's CPU time, its ffmpeg children's CPU time (they are
-waited for inside the span), and the cores' idle time over the span (from /proc/stat: the whole machine's, so run
-it on a quiet one). The floor's span is its Encoder's, from its creation to the end of close(), as the bench
-times it; recording the floor's frames beforehand is not in it.
+(render/commands/bench.py's phase_encode, and pipeline.render as its timed_render runs it, after a one-frame
+warm-up render), alternating, once a round. For each it prints the wall time, this process's CPU time, its
+ffmpeg children's CPU time (they are waited for inside the span), and the cores' idle time over the span (from
+/proc/stat: the whole machine's, so run it on a quiet one). The floor's span is its Encoder's, from its creation
+to the end of close(), as the bench times it; recording the floor's frames beforehand is not in it.
 
 A render cannot take less wall time than its CPU time shared perfectly over the cores, so the last line divides
 the median render's CPU time by the core count and by the median floor: the end_to_end_over_encode_floor that a
