@@ -9,7 +9,9 @@ Source.next_frame (simulate and draw the video's frame, its HUD included), gif.F
 frame), Hud.draw (within both), yuv.convert (the MP4's yuv420p), the rest of Encoder.write (handing frames
 to the pipes: its wall time beyond its CPU time is waiting on an encoder) and Encoder.close (after the last
 frame). The stages nest: the frames' figures include the HUD's, write's the conversion's. Kernels compiled
-on a first run are in the first run's figures.
+on a first run are in the first run's figures. Each stage's slowest call, and which call it was, shows where
+each new object's kernels first go through Taichi's front end and the cache (the GIF's canvas: at its first
+frame, the video's second).
 
 Then the render's timeline, in seconds from its start: when the first frame reached the Encoder, when the
 last one had been handed over, when each ffmpeg process exited (x264's first, then the GIF's palettegen;
@@ -41,14 +43,18 @@ STAGES = [(pipeline.Source, "next_frame", "video frame (simulate + draw + HUD)")
 
 
 def timed(fn, totals):
+    """fn, adding its wall and CPU time to totals[0:2], counting calls in totals[2], and keeping its slowest
+    call as (wall, call number) in totals[3]: a kernel's first launch (front end, cache) shows there."""
     def wrapper(*args, **kwargs):
         wall, cpu = time.perf_counter(), time.thread_time()
         try:
             return fn(*args, **kwargs)
         finally:
-            totals[0] += time.perf_counter() - wall
+            took = time.perf_counter() - wall
+            totals[0] += took
             totals[1] += time.thread_time() - cpu
             totals[2] += 1
+            totals[3] = max(totals[3], (took, totals[2]))
     return wrapper
 
 
@@ -89,7 +95,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="render-threads-") as tmp:
         if args.warm:
             pipeline.render(scene.replace(video={"duration": 1.0 / scene.video.fps}), Path(tmp) / "warm")
-        stats, marks = collections.defaultdict(lambda: [0.0, 0.0, 0]), {}
+        stats, marks = collections.defaultdict(lambda: [0.0, 0.0, 0, (0.0, 0)]), {}
         for owner, name, label in STAGES:
             setattr(owner, name, timed(getattr(owner, name), stats[label]))
         timeline(marks)
@@ -99,10 +105,11 @@ def main(argv=None) -> int:
         wall, cpu = end - wall, time.process_time() - cpu
     print(f"{args.preset} (x264 {mp4.PRESET}): pipeline.render {wall:.2f} s wall, {cpu:.2f} s CPU of this process (all its threads)")
     print(f"timings_s: {meta['timings_s']}")
-    print("| stage | calls | wall s | main thread CPU s | wall ms a call |\n|---|---:|---:|---:|---:|")
+    print("| stage | calls | wall s | main thread CPU s | wall ms a call | slowest call ms (its number) |\n"
+          "|---|---:|---:|---:|---:|---:|")
     for _, _, label in STAGES:
-        w, c, n = stats[label]
-        print(f"| {label} | {n} | {w:.2f} | {c:.2f} | {1e3 * w / max(n, 1):.2f} |")
+        w, c, n, (slow, which) = stats[label]
+        print(f"| {label} | {n} | {w:.2f} | {c:.2f} | {1e3 * w / max(n, 1):.2f} | {1e3 * slow:.1f} ({which}) |")
     start = end - wall
     print("timeline, s from the render's start: " + ", ".join(
         f"{k} {v - start:.2f}" for k, v in sorted(marks.items(), key=lambda kv: kv[1])))

@@ -39,7 +39,7 @@ SIZE = ["video.width=1280", "video.height=720"]
 # whole 10 s too: its fps counts the certificate, about 1.2 s at 720p whatever the length, which was a tenth
 # of a 2 s map's wall (9.89 fps there, 2026-12-04) and is a fiftieth of the map a user renders. The others cost
 # about the same every frame, so 2 s tell (the FTLE map 1 s: 30 frames at 720p, 8.3 s in all on 2026-12-07,
-# docs/performance.md).
+# docs/performance-log.md).
 # rounds: interleaved rounds of every comparison with a peer, and how many times the end-to-end render and its
 # encode floor are timed (--repeat); peer_s: seconds of rigid_chaos that both sides render and draw in the
 # matplotlib phase (10 s: 600 frames); warm_maps: render a map's first frame before timing it (phase_fractal).

@@ -107,7 +107,7 @@ def sincos_f32(x):
     # j itself, not k converted back: the same value (|j| < 2^31 wherever _guard lets a result through), so the
     # same bits, and one conversion fewer a call: the rigid f32 RK4 kernel at N = 1e5 took 5-7 % more steps a
     # second (alternating, timed by a script not kept), and `pendulum bench`'s f32 peak fraction went from
-    # 0.266-0.268 to 0.286-0.287 (AVX-512, docs/performance.md)
+    # 0.266-0.268 to 0.286-0.287 (AVX-512, docs/performance-log.md)
     r = (xd - j * ti.f64(P1)) - j * ti.f64(P1T)
     rf = ti.cast(r, ti.f32)
     zf = rf * rf

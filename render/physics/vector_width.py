@@ -3,10 +3,10 @@
 Taichi 1.7.4 compiles kernels with LLVM 15 for the host CPU by name, and LLVM's tuning for Intel's AVX-512
 CPUs (Skylake-X to Sapphire Rapids) prefers 256-bit vectors: the rigid f64 advance's optimised IR holds 849
 `<4 x double>` operations and none wider, so half of every register sat idle (779 `<16 x double>` at 16
-lanes; TI_PRINT_KERNEL_LLVM_IR_OPTIMIZED=1, docs/performance.md). No ti.init option sets the width, but LLVM's
+lanes; TI_PRINT_KERNEL_LLVM_IR_OPTIMIZED=1, docs/performance-log.md). No ti.init option sets the width, but LLVM's
 own command-line options live in Taichi's library, and `-force-vector-width=16` has the loop vectoriser take
 16 lanes in every loop it vectorises: a group of 16 f64 pendulums (System.CHUNK) in two 512-bit registers a
-value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance.md).
+value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance-log.md).
 
 No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
 what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0 and 16 lanes).

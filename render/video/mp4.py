@@ -54,7 +54,7 @@ def x264_threads() -> list[str]:
     22.5-22.8 s (alternating, two each), and after this round's cheaper drawing 24.5 s to 22.7 s (3
     interleaved rounds). Since the drawing got cheaper still, one thread no longer clearly pays: renders within
     3 % of two threads' (and of x264's own count), with x264 alone on two threads 4 % above one in CPU (late
-    2026-12-06, docs/performance.md). It is kept for that CPU, which renders running side by side share
+    2026-12-06, docs/performance-log.md). It is kept for that CPU, which renders running side by side share
     (`batch`); where x264 is all a render waits for, a fan light to draw, its own threads would be quicker."""
     # config/options.py's usable_cores(), which sits a layer above this one (docs/architecture.md)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
