@@ -23,10 +23,10 @@ FADE_S = 0.02  # raised-cosine fades at both ends: no click where the track star
 PEAK = 10 ** (-1 / 20)  # -1 dBFS: headroom for the AAC encoder's overshoot
 CHUNK = 1 << 14  # samples levelled at once (level)
 # Frames made at once (Track): their work arrays, VOICES x 2 x 1600 floats at 60 fps (0.8 MB), stay in the cache.
-# rigid_chaos's own 64 voices over its 1200 frames (pipeline.record's angles), synthesise() in 6 rounds: 0.33-0.37 s
-# in chunks of 20 frames into new arrays (before), 0.28-0.34 s in chunks of 2 into the same arrays, 0.31-0.40 in
-# chunks of 4, 0.34-0.40 in chunks of 8 (a script, 2-core Xeon, AVX-512, 2026-12-07). The samples are the same to
-# the bit at any chunk size: each is made by the same elementwise steps.
+# rigid_chaos's own 64 voices over its 1200 frames (pipeline.record's angles), synthesise() in 6 rounds: 0.24-0.27 s
+# in chunks of 2, 0.24-0.28 in chunks of 4, 0.27-0.28 in chunks of 8 (`python benchmarks/audio_track.py --chunks 2
+# 4 8`, 2-core Xeon, AVX-512, 2026-12-07). The samples are the same to the bit at any chunk size: each is made by
+# the same elementwise steps.
 CHUNK_FRAMES = 2
 
 
@@ -40,8 +40,8 @@ def peak_bytes(scene) -> int:
     """What making the track holds at most (render/config/budget.py counts it): the float32 samples, 8 bytes a
     stereo sample, held from the first frame, and while level() evens out a channel its squares in float32 and
     again in float64, 12 bytes more (4 to spare for numpy's smaller temporaries); a chunk's work arrays, two float32
-    ones of its samples for every voice; its pitches and phases. tracemalloc: 22.0 MB for rigid_chaos (a script
-    feeding Voices 1200 frames of 64 voices, then track()), against 24.7 MB here."""
+    ones of its samples for every voice; its pitches and phases. tracemalloc: 20.9 MB for rigid_chaos (a Track fed
+    its 1200 frames of 64 voices, then finished: `python benchmarks/audio_track.py`), against 24.7 MB here."""
     voices = min(VOICES, scene.pendulums.count)
     per = -(-AUDIO_RATE // scene.video.fps)
     work = (CHUNK_FRAMES + 1) * voices * 8 * (registry.get(scene.system).D + 2 * 5)
@@ -91,8 +91,9 @@ def synthesise(angles: np.ndarray, fps: int, rate: int = AUDIO_RATE) -> tuple[in
 class Track:
     """The track of `frames` frames, made as their angles come (add()), so that after the last frame only its end
     and the levelling are left (finish()). In a render that is the part after the last frame, when nothing else
-    of ours runs and the MP4's track waits for it: rigid_chaos's whole synthesis there took 0.35 s, its mux 0.46
-    s after it (timestamps around Encoder.close, 2-core Xeon, AVX-512, 2026-12-07).
+    of ours runs and the MP4's track waits for it: rigid_chaos's track takes 0.24-0.27 s made whole, and fed frame
+    by frame leaves 0.018-0.022 s to finish() (`python benchmarks/audio_track.py`, 6 rounds, 2-core Xeon, AVX-512,
+    2026-12-07).
 
     Frame f is shown from f/fps to (f+1)/fps and the pitch glides linearly from its value to the next frame's
     (the last holds): each voice's phase, the integral of its pitch, is then exact in closed form, with no voice

@@ -134,9 +134,11 @@ _NO_TILES = np.zeros((1, 1), np.int32)  # `lit` where no tiles are known: every 
 def convert(frame: np.ndarray, lit: tuple[np.ndarray, int] | None = None) -> np.ndarray:
     """An H×W×3 uint8 RGB frame (fits()) as a new yuv420p frame: the Y plane, then Cb, then Cr. `lit`, (tiles,
     side) from the canvas that drew the frame (render/draw/compose.py's lit_tiles), says which side×side tiles
-    may hold anything but black; the others are not read: every 10th frame of rigid_chaos's first 10 s, out of
-    the cache, median 0.73 ms a frame without, 0.58-0.60 ms with (2-core Xeon, AVX-512, 2026-12-07, a script
-    converting copies of them). Taichi must run: a Run starts it (render/physics/stepper.py)."""
+    may hold anything but black; the others are not read. rigid_chaos's 1200 frames, each read from memory
+    (`python benchmarks/yuv_pipe.py --convert-only --evict 64`, twice; 2-core Xeon, AVX-512, 2026-12-07): median
+    0.81-0.82 ms a frame reading every tile, 0.77-0.78 ms the lit ones; right after drawing (no --evict), the
+    frame still in the cache, 0.56-0.57 and 0.55-0.56 ms. Taichi must run: a Run starts it
+    (render/physics/stepper.py)."""
     if runtime.generation() == 0:
         raise RuntimeError("yuv.convert: Taichi is not running (a Run starts it)")
     h, w = frame.shape[:2]
