@@ -62,6 +62,8 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=int, default=60, help="frames timed (default 60)")
     ap.add_argument("--warm", action="store_true", help="render one frame first, as pendulum bench does")
     args = ap.parse_args(argv)
+    if args.frames < 2:
+        ap.error("--frames: at least 2 (the first frames, then the steady ones)")
     scene = load(args.preset)
     if args.warm:
         with tempfile.TemporaryDirectory() as tmp:
@@ -71,8 +73,8 @@ def main(argv=None) -> int:
     spinner = Spinner()
     sys.setswitchinterval(SWITCH_S)
     spinner.thread.start()
-    rows = []  # (what, wall ms, held ms, longest ms, frames)
-    steady = [0.0, 0.0, 0.0, 0]
+    rows = []  # (what, wall ms, held ms, longest ms)
+    steady = [0.0, 0.0, 0.0, 0]  # over the steady frames: wall ms, held ms, the longest, how many
     for f in range(min(args.frames, src.frames)):
         t0 = time.perf_counter()
         frame = src.next_frame()
@@ -80,19 +82,19 @@ def main(argv=None) -> int:
         gif_frame = small.frame(f, frame) if small else None
         t2 = time.perf_counter()
         if f == 0:
-            rows.append(("video's first frame", 1e3 * (t1 - t0), *spinner.held(t0, t1), 1))
+            rows.append(("video's first frame", 1e3 * (t1 - t0), *spinner.held(t0, t1)))
         if small and small.own is not None and gif_frame is not None and len(rows) == 1:
-            rows.append(("GIF's first frame", 1e3 * (t2 - t1), *spinner.held(t1, t2), 1))
+            rows.append(("GIF's first frame", 1e3 * (t2 - t1), *spinner.held(t1, t2)))
         elif f > 0:
             held, longest = spinner.held(t0, t2)
             steady = [steady[0] + 1e3 * (t2 - t0), steady[1] + held, max(steady[2], longest), steady[3] + 1]
     spinner.stop = True
     spinner.thread.join()
     n = max(steady[3], 1)
-    rows.append((f"a steady frame, video and GIF (mean of {steady[3]})", steady[0] / n, steady[1] / n, steady[2], n))
+    rows.append((f"a steady frame, video and GIF (mean of {steady[3]})", steady[0] / n, steady[1] / n, steady[2]))
     print(f"{args.preset}: the GIL held in stretches over {STALL_MS:g} ms (switch interval {SWITCH_S * 1e3:g} ms)")
     print("| what | wall ms | held ms | longest ms |\n|---|---:|---:|---:|")
-    for what, wall, held, longest, _ in rows:
+    for what, wall, held, longest in rows:
         print(f"| {what} | {wall:.1f} | {held:.1f} | {longest:.1f} |")
     return 0
 
