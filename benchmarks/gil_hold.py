@@ -2,8 +2,8 @@
 
     .venv/bin/python benchmarks/gil_hold.py [PRESET] [--frames 60] [--warm]
 
-Builds PRESET's frames as `pendulum render` does (pipeline.Source, and the GIF's own canvas, gif.Frames) while a
-second Python thread spins, noting how long it waits between two turns. Python threads take turns every
+Builds PRESET's frames as `pendulum render` does (pipeline.open_source, and the GIF's own frames, gif.Frames)
+while a second Python thread spins, noting how long it waits between two turns. Python threads take turns every
 sys.getswitchinterval(), set to 0.2 ms here, so a wait over STALL_MS is a stretch where the main thread held
 the GIL without giving it up: Taichi's compiling or running a kernel (its Python bindings do not release it).
 Printed for the video's first frame (its canvas's kernels through Taichi's front end, the offline cache and a
@@ -68,7 +68,7 @@ def main(argv=None) -> int:
     if args.warm:
         with tempfile.TemporaryDirectory() as tmp:
             pipeline.render(scene.replace(video={"duration": 1.0 / scene.video.fps}), Path(tmp))
-    src = pipeline.Source(scene)
+    src = pipeline.open_source(scene)
     small = gif.Frames(src, src.scene.video, src.timings) if "gif" in src.scene.video.formats else None
     spinner = Spinner()
     sys.setswitchinterval(SWITCH_S)
