@@ -1,7 +1,9 @@
 """Shared fixtures. Taichi has one runtime per process; a Run (render/physics/stepper.py) starts the one it needs."""
 import os
+import shutil
 import subprocess
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -137,6 +139,20 @@ def run_cli(*args, cwd=None, timeout=300, **kw):
 # kernels is most of a render's cost here, so one render serves both (on one worker: SHARE_A_WORKER).
 SMALL_W, SMALL_H, SMALL_FPS, SMALL_SECONDS = 256, 144, 10, 3.0
 PICKS = {"first": 0, "early": 5, "later": 29}  # t = 0, 0.5 s, 2.9 s: well before f64 round-off matters
+
+
+@contextmanager
+def immutable(path: Path):
+    """`path` made immutable with chattr +i (root cannot write it either); skips where that is not possible."""
+    if shutil.which("chattr") is None:
+        pytest.skip("chattr is not installed (Debian: e2fsprogs)")
+    made = subprocess.run(["chattr", "+i", str(path)], capture_output=True, text=True)
+    if made.returncode:
+        pytest.skip(f"chattr +i does not work here: {made.stderr.strip()}")
+    try:
+        yield path
+    finally:
+        subprocess.run(["chattr", "-i", str(path)], check=True)
 
 
 def small_scene(name):

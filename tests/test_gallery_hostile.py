@@ -8,6 +8,7 @@ file outside, nested 100000 deep, of the wrong shape, with 10**400 in it, over t
 writer. The directory outside is snapshotted (listing, contents, mtimes, and atimes set older than mtimes, so
 that relatime records any read or listing) before and after the command.
 """
+import contextlib
 import errno
 import hashlib
 import json
@@ -21,7 +22,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import run_cli
+from conftest import immutable, run_cli
 from render.video import atomic
 from render.commands import confined, gallery
 from render.config.scene import load
@@ -278,23 +279,18 @@ def test_the_sweeper_never_enters_a_symlinked_folder(tmp_path):
 @pytest.mark.parametrize("folder", ["/sys/kernel", "readonly"])
 def test_an_unwritable_gallery_folder_is_bad_input(tmp_path, folder):
     """A folder no one may write: as root (CI), one made immutable (chattr +i), which stops root too."""
-    reason, pinned = os.strerror(errno.EACCES), False
+    reason, pinned = os.strerror(errno.EACCES), contextlib.nullcontext()
     if folder == "readonly":
         folder = tmp_path / "readonly"
         folder.mkdir()
         if os.geteuid() == 0:
-            made = subprocess.run(["chattr", "+i", str(folder)], capture_output=True, text=True)
-            assert made.returncode == 0, f"chattr +i (Debian: e2fsprogs): {made.stderr}"
-            reason, pinned = os.strerror(errno.EPERM), True
+            reason, pinned = os.strerror(errno.EPERM), immutable(folder)
         else:
             folder.chmod(0o555)
     elif not os.path.isdir(folder):
         pytest.skip(f"no {folder} here")
-    try:
+    with pinned:
         r = run_cli("gallery", "--out", folder, timeout=TIMEOUT_S)
-    finally:
-        if pinned:
-            subprocess.run(["chattr", "-i", str(folder)], check=True)
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2 and len(lines) == 1, r.stderr
     assert lines[0] == f"pendulum: error: --out {folder}: cannot write the gallery there: {reason}"

@@ -134,6 +134,14 @@ def test_the_readme_is_a_front_page():
     assert "apt-get install" in text  # the system packages the skipped tests need
 
 
+def test_the_readme_preset_is_the_file_it_names():
+    """"## A preset" shows presets/NAME.toml, the file it names, as it is."""
+    section = (ROOT / "README.md").read_text().split("\n## A preset\n", 1)[1].split("\n## ", 1)[0]
+    name = re.search(r"this is `(presets/\w+\.toml)`", section).group(1)
+    block = re.search(r"```toml\n(.*?)```", section, re.S).group(1)
+    assert block == (ROOT / name).read_text()
+
+
 def test_the_readme_commands_table_names_every_subcommand():
     from render.commands.cli import build_parser
     sub = next(a for a in build_parser()._actions if a.dest == "command")

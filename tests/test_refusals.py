@@ -17,12 +17,11 @@ import subprocess
 import sys
 import threading
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, immutable, run_cli
 from render.commands.show import DISPLAY_TIMEOUT_S
 
 SMALL = ["--set", "video.width=256", "--set", "video.height=144", "--set", "video.duration=1"]
@@ -48,20 +47,6 @@ def refused(r, tmp_path, *needles):
 
 def tree(folder: Path) -> list[str]:
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.name != "ticache")
-
-
-@contextmanager
-def immutable(path: Path):
-    """`path` made immutable with chattr +i (root cannot write it either); skips where that is not possible."""
-    if shutil.which("chattr") is None:
-        pytest.skip("chattr is not installed (Debian: e2fsprogs)")
-    made = subprocess.run(["chattr", "+i", str(path)], capture_output=True, text=True)
-    if made.returncode:
-        pytest.skip(f"chattr +i does not work here: {made.stderr.strip()}")
-    try:
-        yield path
-    finally:
-        subprocess.run(["chattr", "-i", str(path)], check=True)
 
 
 # ------------------------------------------------------------------ 1. the preset search path
