@@ -276,6 +276,25 @@ def test_the_sweeper_never_enters_a_symlinked_folder(tmp_path):
     assert atomic.sweep_stale(tmp_path / "real") == stale and not any(p.exists() for p in stale)
 
 
+def test_the_sweeper_takes_only_what_temp_beside_makes(tmp_path):
+    """A user's files that look like a dead writer's temporaries, but for mkstemp's 8 characters or a suffix
+    this package never uses, stay; a real one of a dead writer goes."""
+    pid = dead_pid()
+    mine = [tmp_path / f".db.{atomic.HOST}-{pid}.snap.gz", tmp_path / f".backup.{atomic.HOST}-{pid}.v1.tar",
+            tmp_path / f".x.mp4.{atomic.HOST}-{pid}.abcdefgh.tar", tmp_path / f".x.mp4.{atomic.HOST}-{pid}.abcdefghi.part"]
+    for f in mine:
+        f.write_text("mine")
+    old = time.time() - 2 * atomic.FOREIGN_STALE_S
+    foreign = tmp_path / f".db.deadbeef-{pid}.snapshot.gz"
+    foreign.write_text("mine")
+    os.utime(foreign, (old, old))
+    real = stale_temporaries(tmp_path, "x.mp4")
+    assert atomic.sweep_stale(tmp_path) == real
+    assert all(f.exists() for f in [*mine, foreign])
+    with pytest.raises(ValueError, match="suffix"):
+        atomic.temp_beside(tmp_path / "x.tar", suffix=".tar")
+
+
 @pytest.mark.parametrize("folder", ["/sys/kernel", "readonly"])
 def test_an_unwritable_gallery_folder_is_bad_input(tmp_path, folder):
     """A folder no one may write: as root (CI), one made immutable (chattr +i), which stops root too."""

@@ -19,13 +19,18 @@ from pathlib import Path
 
 FOREIGN_STALE_S = 7 * 24 * 3600  # a week: far longer than any render the step budget lets start
 HOST = f"{zlib.crc32(socket.gethostname().encode()):08x}"
-_OWNED = re.compile(r"\..+\.([0-9a-f]{8})-(\d+)\.[a-z0-9_]+\.[A-Za-z0-9]+")  # what temp_beside creates
+SUFFIXES = (".part", ".jpg", ".npz")  # the temporaries this package makes (a poster, a trajectory: their writers' own)
+# What temp_beside creates, exactly: mkstemp's 8 characters and one of SUFFIXES. A looser pattern took a user's
+# own .db.deadbeef-1.snap.gz for a dead writer's temporary and removed it.
+_OWNED = re.compile(r"\..+\.([0-9a-f]{8})-(\d+)\.[a-z0-9_]{8}(?:%s)" % "|".join(map(re.escape, SUFFIXES)))
 
 
 def temp_beside(path: Path, suffix: str = ".part") -> Path:
     """A new, empty, hidden file in the same directory as `path` (so the final rename is atomic); stale
     temporaries of dead writers in that directory are swept first."""
     path = Path(path)
+    if suffix not in SUFFIXES:
+        raise ValueError(f"temp_beside: suffix {suffix!r} is not one the sweeper knows ({', '.join(SUFFIXES)})")
     sweep_stale(path.parent)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{HOST}-{os.getpid()}.", suffix=suffix, dir=path.parent)
     os.close(fd)
