@@ -222,6 +222,33 @@ def test_bad_command_line_exits_2(argv, needle, tmp_path, capsys):
     assert not list(tmp_path.iterdir())
 
 
+def test_a_batch_that_can_render_nothing_is_bad_input(tmp_path, capsys):
+    """Every preset refused before any work (a malformed file, one over its budget): exit 2, one line, nothing
+    written, as for a lone render; not a batch that ran and failed (exit 1, batch.json)."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text('system = "rigid\n')
+    out = tmp_path / "out"
+    assert main(["batch", str(bad), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(bad) in err[0] and not out.exists()
+    assert main(["batch", str(bad), "classic", "--set", "integrator.dt=1e-9", "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "and 1 more preset(s)" in err[0] and not out.exists()
+
+
+def test_a_batch_never_renders_through_a_symlinked_folder(tmp_path, capsys):
+    """OUT/NAME a symlink that leads out of OUT: that preset is refused before any work, as `render` refuses it."""
+    out, outside = tmp_path / "out", tmp_path / "outside"
+    out.mkdir()
+    outside.mkdir()
+    sets = ["video.duration=0.1", "video.width=64", "video.height=36"]
+    (out / batch_plan.plan(["classic"], sets, [])[0]["name"]).symlink_to(outside)
+    assert main(["batch", "classic", *(a for s in sets for a in ("--set", s)), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is a symlink" in err[0]
+    assert not list(outside.iterdir())
+
+
 def test_bad_jobs_is_a_usage_error(capsys):
     with pytest.raises(SystemExit) as e:
         main(["batch", "--jobs", "0"])

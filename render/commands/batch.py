@@ -23,8 +23,8 @@ from .batch_plan import expand_refs, parse_sweeps, plan
 from ..physics import registry
 from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
-from ..config.options import (add_budget, add_common, add_quality, budgeted, check_writable, positive_int,
-                              progress_wanted, thread_count, usable_cores)
+from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
+                              positive_int, progress_wanted, thread_count, usable_cores)
 from ..video.tiled import connect, scheduler_address
 from ..video.version import __version__
 
@@ -150,8 +150,9 @@ def run(args) -> int:
     todo = []
     for job in jobs_plan:
         if "scene" in job:
-            try:  # what each render costs, refused before any work as a bad preset is
+            try:  # where each render writes and what it costs, refused before any work as a bad preset is
                 job["scene"] = budgeted(job["scene"], args)
+                check_out_folder(job["scene"], out_root)  # e.g. OUT/NAME a symlink leading out of OUT
                 budget.check(job["scene"], registry.get(job["scene"].system), out_root)
             except SceneError as e:
                 job["error"] = str(e)
@@ -161,6 +162,11 @@ def run(args) -> int:
             rows[job["name"]] = gallery.row_from_meta(job["name"], "skipped", meta, None)
         else:
             todo.append(job["scene"])
+    if not todo and all(r["status"] == "failed" for r in rows.values()):
+        # nothing can run: bad input as a lone render's would be (exit 2, nothing written), not a batch that failed
+        first = rows[jobs_plan[0]["name"]]["error"]
+        more = f" (and {len(jobs_plan) - 1} more preset(s) refused likewise)" if len(jobs_plan) > 1 else ""
+        raise SceneError(f"{first}{more}")
     if todo:
         budget.check_run(todo, out_root)  # the renders to do, summed: refused together before the first
     n, done = len(jobs_plan), 0
