@@ -165,6 +165,33 @@ def test_simulate_to_a_full_disk_fails_with_one_line_and_leaves_nothing(tmp_path
     assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
 
 
+def test_a_render_that_fails_after_its_videos_are_finished_publishes_none_of_them(tmp_path, monkeypatch):
+    """The MP4, GIF, still and map data are finished in their temporaries and published only with metadata.json:
+    a failure in between (a full disk as the metadata is written) leaves none of them, and no temporary."""
+    import errno
+    from render.config.scene import load
+    from render.video import pipeline
+
+    def full(*a, **k):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(pipeline, "metadata", full)
+    scene = load("fractal_flip", ["video.width=64", "video.height=36", "video.duration=0.2",
+                                  'video.formats=["mp4", "gif", "png"]'])
+    with pytest.raises(OSError, match=os.strerror(errno.ENOSPC)):
+        pipeline.render(scene, tmp_path)
+    assert not list(tmp_path.rglob("*"))  # no file, no temporary, and the folder made for them is gone
+
+
+def test_a_publish_that_fails_names_the_file_asked_for_not_the_temporary(tmp_path):
+    from render.video import atomic
+    (tmp_path / "x.mp4").mkdir()
+    tmp = atomic.temp_beside(tmp_path / "x.mp4")
+    with pytest.raises(IsADirectoryError) as e:
+        atomic.publish(tmp, tmp_path / "x.mp4")
+    assert e.value.filename == str(tmp_path / "x.mp4") and str(tmp_path / "x.mp4") in str(e.value)
+
+
 def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
     (tmp_path / "p.toml").write_text(GOOD.format(name="p"))
     first = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)

@@ -131,7 +131,7 @@ def test_load_map_refuses_what_is_not_a_map(tmp_path):
 def test_a_render_that_fails_as_it_finishes_leaves_no_npz(tmp_path, monkeypatch):
     from render.video import encode
 
-    def failing(self, audio=None):
+    def failing(self, audio=None, publish=True):
         self.abort()
         raise EncodeError("ffmpeg failed (a test)")
 

@@ -92,6 +92,33 @@ def test_render_into_a_folder_that_is_a_symlink_out_of_out_is_refused_up_front(t
     assert tree(elsewhere) == [] and tree(out) == ["small"]
 
 
+
+@pytest.mark.parametrize("command, folder, name", [
+    (["render", "classic", "--name", "x"], "x", "metadata.json"),
+    (["render", "classic", "--name", "x"], "x", "x.gif"),
+    (["render", "fractal_flip", "--name", "x"], "x", "x.npz"),
+    (["compare", "classic", "--vary", "integrator.precision=f32,f64", "--name", "x"], "compare/x", "metadata.json"),
+    (["lyapunov", "classic", "--set", "video.duration=0.5"], "classic__5995f708", "lyapunov.json"),
+])
+def test_a_folder_where_an_output_file_goes_is_refused_up_front(tmp_path, command, folder, name):
+    """A file is renamed onto its name when it is finished: onto a folder that fails, after all the work, with
+    the outputs before it published. So it is bad input, refused before the work, and nothing is written."""
+    out = tmp_path / "out"
+    (out / folder / name).mkdir(parents=True)
+    args = [*command, *(SMALL if command[0] != "lyapunov" else []), "--out", out]
+    refused(cli(tmp_path, *args), tmp_path, str(out / folder / name), "is a folder")
+    assert tree(out / folder) == [name]
+
+
+def test_lyapunov_into_a_folder_that_is_a_symlink_out_of_out_is_refused_up_front(tmp_path):
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "classic").symlink_to(elsewhere)
+    refused(cli(tmp_path, "lyapunov", "classic", "--out", out), tmp_path, f"{out / 'classic'} is a symlink")
+    assert tree(elsewhere) == []
+
+
 # ------------------------------------------------------------------ 3. outputs even root cannot write
 def test_simulate_onto_an_immutable_file_is_refused_up_front(tmp_path):
     target = tmp_path / "t.npz"

@@ -8,8 +8,9 @@ import argparse
 import json
 from pathlib import Path
 
-from ..errors import SceneError
-from ..config.options import add_common, check_writable, output_name, progress_wanted, thread_count
+from ..config.options import add_common, check_out_folder, output_name, progress_wanted, thread_count
+
+FILES = ("lyapunov.png", "lyapunov.json")  # what it writes into OUT/NAME/
 
 EPILOG = """examples:
   pendulum lyapunov classic
@@ -57,21 +58,21 @@ def add_parser(sub):
 def run(args) -> int:
     from . import charts
     from ..trust import lyapunov
-    from ..video.atomic import write_atomic
+    from ..video.atomic import replacing
     from ..config.scene import load
 
     scene = output_name(load(args.preset, args.overrides), bool(args.overrides))
     pendulums = lyapunov.chosen(scene, args.pendulums)
     lyapunov.check(scene, pendulums)
-    check_writable(args.out)
+    check_out_folder(scene, args.out, FILES)  # a file, a symlink or a folder where these go: before the work
     out_dir = scene.out_dir(args.out)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise SceneError(f"--out {args.out}: {out_dir} is a file; the spectrum is written into a folder of that name")
     doc, run_ = lyapunov.measure(scene, pendulums, args.arch, args.threads, progress_wanted(args))
     out_dir.mkdir(parents=True, exist_ok=True)
-    charts.lyapunov_chart(out_dir / "lyapunov.png", run_["t"], run_["running"], [int(i) for i in pendulums],
-                          scene.name, doc["pendulums"][0]["checks"]["expected_sum"])
-    write_atomic(out_dir / "lyapunov.json", json.dumps(doc, indent=2) + "\n")
+    png, js = (out_dir / f for f in FILES)
+    with replacing(js) as tmp:  # the numbers, then the chart, then the numbers published: a failure leaves neither
+        tmp.write_text(json.dumps(doc, indent=2) + "\n")
+        charts.lyapunov_chart(png, run_["t"], run_["running"], [int(i) for i in pendulums], scene.name,
+                              doc["pendulums"][0]["checks"]["expected_sum"])
     for row in doc["pendulums"]:
         print(line(row))
     print(f"{scene.name}: {len(pendulums)} pendulum(s), {doc['pendulums'][0]['duration_s']:g} s, "

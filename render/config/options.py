@@ -196,10 +196,10 @@ def check_writable(path: Path, what: str = "--out"):
                          f"{e.strerror or e})") from None
 
 
-def check_out_folder(scene, out: Path):
+def check_out_folder(scene, out: Path, files: tuple[str, ...] | None = None):
     """Bad input before any work: OUT cannot be written, the scene's folder there (OUT/NAME/, a comparison's
-    OUT/compare/NAME/) or OUT/compare/ is a file or cannot be written, or an output file in it cannot be
-    replaced. Each would fail only after the simulation."""
+    OUT/compare/NAME/) or OUT/compare/ is a file, a symlink or cannot be written, or an output file in it (a
+    render's, or `files`) cannot be replaced. Each would fail only after the simulation."""
     check_writable(out)
     folder = scene.out_dir(out)
     for above in (folder, folder.parent):
@@ -208,12 +208,15 @@ def check_out_folder(scene, out: Path):
         if above != out and above.exists() and not above.is_dir():
             raise SceneError(f"--out {out}: {above} is a file; {scene.name} renders into {folder}{os.sep}")
     check_writable(folder)  # e.g. an immutable OUT/NAME/
-    for name in [*(f"{scene.name}.{fmt}" for fmt in scene.video.formats), "metadata.json"]:
+    if files is None:  # a render's: its videos and still, a map's data, its metadata
+        files = (*(f"{scene.name}.{fmt}" for fmt in scene.video.formats), *([f"{scene.name}.npz"] if scene.fractal
+                                                                            else []), "metadata.json")
+    for name in files:
         check_replaceable(folder / name)
 
 
 def check_replaceable(path: Path, what: str = "--out"):
-    """Bad input if `path` is a file that is there and cannot be replaced by renaming a finished file onto it
+    """Bad input if `path` is a folder, or a file that is there and cannot be replaced by renaming a finished file onto it
     (render/video/atomic.py), which would fail only after the work. Even root cannot replace an immutable or
     append-only file (chattr +i, +a); no one but its owner, the folder's or root one in a sticky folder."""
     try:
@@ -221,6 +224,8 @@ def check_replaceable(path: Path, what: str = "--out"):
     except OSError:
         return  # not there: check_writable judges its folder
     why = None
+    if stat.S_ISDIR(st.st_mode):  # a file is renamed onto its name: never onto a folder
+        raise SceneError(f"{what} {path}: is a folder, where a file of that name is written; move it away")
     if _pinned(path, st):
         why = "the file is immutable or append-only; lsattr shows which"
     elif folder.st_mode & stat.S_ISVTX and os.geteuid() not in (0, st.st_uid, folder.st_uid):

@@ -79,8 +79,11 @@ def _alive(pid: int) -> bool:
 
 def publish(tmp: Path, path: Path):
     """Rename a finished temporary file onto its final path, readable like any other output."""
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    try:
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except OSError as e:  # name the file the user asked for, not our hidden temporary
+        raise OSError(e.errno, e.strerror, str(path)) from e
 
 
 @contextmanager

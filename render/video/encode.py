@@ -198,9 +198,11 @@ class Encoder:
         for s in self.stills:
             s.frame = frame  # shared like the queues' frames: only the last one is kept
 
-    def close(self, audio: tuple[int, np.ndarray] | None = None) -> dict[str, int]:
+    def close(self, audio: tuple[int, np.ndarray] | None = None, publish: bool = True) -> dict[str, int]:
         """Finish encoding and rename into place; returns file name -> bytes. `audio`, (rate, int16 samples
-        (S, 2)), is muxed into the MP4 (see _mux)."""
+        (S, 2)), is muxed into the MP4 (see _mux). publish=False leaves the finished files in their temporaries
+        (done()) until publish(), so that a caller can publish them together with files of its own; until then
+        abort() removes them."""
         for t in self.targets:
             if not t.ended:
                 t.queue.put(None)
@@ -234,14 +236,22 @@ class Encoder:
             if muxed:
                 self.abort()
                 raise muxed[0]
-        sizes = {}
-        for t in [*self.targets, *self.stills]:
-            publish(t.tmp, t.final)
-            sizes[t.final.name] = t.final.stat().st_size
         for t in self.targets:
             t.log.close()
-        self.targets, self.stills = [], []
+        sizes = {t.final.name: t.tmp.stat().st_size for t in [*self.targets, *self.stills]}
+        if publish:
+            self.publish()
         return sizes
+
+    def done(self) -> list[tuple[Path, Path]]:
+        """(temporary, final) of each finished file, after close(publish=False)."""
+        return [(t.tmp, t.final) for t in [*self.targets, *self.stills]]
+
+    def publish(self):
+        """Rename the finished files into place (after close(publish=False))."""
+        for tmp, final in self.done():
+            publish(tmp, final)
+        self.targets, self.stills = [], []
 
     def abort(self):
         """Stop ffmpeg and remove the temporary files; safe to call more than once."""

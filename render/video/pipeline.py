@@ -14,7 +14,7 @@ from . import audio
 from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
-from .atomic import digest, replacing, write_atomic
+from .atomic import digest, publish, replacing, temp_beside
 from .version import __version__
 
 
@@ -150,21 +150,20 @@ def open_source(scene, arch: str = "cpu", threads: int | None = None, cluster=No
     return SplitScreen(scene, lambda variant: record(variant, arch, threads), arch, threads)
 
 
-@contextmanager
-def map_data(src, out_dir: Path):
-    """A map's NAME.npz (render/maps/data.py), its pixels' data at the last frame, written beside the video
-    before the block and published after it succeeds (removed if it fails); yields the {file: bytes} it adds
-    to the outputs, filled once published. Nothing for a fan."""
-    written = {}
+def map_data(src, out_dir: Path) -> list[tuple[Path, Path]]:
+    """A map's NAME.npz (render/maps/data.py), its pixels' data at the last frame, written into a temporary
+    beside the video: [(temporary, final)], for render() to publish with the rest. Nothing for a fan."""
     if not src.scene.fractal:
-        yield written
-        return
+        return []
     from ..maps import data
     path = out_dir / f"{src.name}.npz"
-    with replacing(path, suffix=".npz") as tmp:  # savez wants the .npz
+    tmp = temp_beside(path, suffix=".npz")  # savez wants the .npz
+    try:
         np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
-        yield written
-    written[path.name] = path.stat().st_size
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return [(tmp, path)]
 
 
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
@@ -190,6 +189,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
         # One frame drawn over each time where nothing keeps it past write(): a new zeroed 720p array took 0.5 ms
         # a frame (allocator and page faults; rigid_chaos, cProfile), refilling one 0.1 ms.
         reuse, buf = not enc.queues_frames and frame_hook is None, None
+        pending = []  # (temporary, final) of the files beside the videos
         try:
             with progress_bar(scene.frames, scene.name, progress) as bar:
                 for f in range(scene.frames):
@@ -210,25 +210,34 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                     timings["encode"] += time.perf_counter() - t
                     bar.update()
             t = time.perf_counter()
-            with map_data(src, out_dir) as data:  # published once the videos are
-                sizes = enc.close(voices.track() if voices else None)  # the track is made and muxed here
-            sizes.update(data)
+            enc.close(voices.track() if voices else None, publish=False)  # the track is made and muxed here
             timings["encode"] += time.perf_counter() - t
+            # Every file is finished in its temporary before any is published, metadata.json last: a failure
+            # (a full disk) leaves none of them, not videos without their metadata.
+            pending += map_data(src, out_dir)
+            files = enc.done() + pending
+            pending.append((temp_beside(out_dir / "metadata.json"), out_dir / "metadata.json"))
+            timings["total"] = time.perf_counter() - t_start
+            sizes = {final.name: tmp.stat().st_size for tmp, final in files}
+            sha256 = {final.name: digest(tmp) for tmp, final in files}
+            meta = metadata(scene, src.arch, src.run_meta(), timings, sizes, sha256)
+            if scene.compare:
+                meta["compare"] = src.compare_meta()
+            if scene.fractal:
+                meta["map"] = src.canvas.summary()
+            if scene.has("poincare"):
+                meta["poincare"] = src.canvas.section.summary()
+            if voices:
+                meta["audio"] = voices.summary()
+            pending[-1][0].write_text(json.dumps(meta, indent=2) + "\n")
+            enc.publish()
+            for tmp, final in pending:
+                publish(tmp, final)
         except BaseException:
             enc.abort()
+            for tmp, _ in pending:
+                tmp.unlink(missing_ok=True)
             raise
-        timings["total"] = time.perf_counter() - t_start
-        sha256 = {f: digest(out_dir / f) for f in sizes}
-        meta = metadata(scene, src.arch, src.run_meta(), timings, sizes, sha256)
-        if scene.compare:
-            meta["compare"] = src.compare_meta()
-        if scene.fractal:
-            meta["map"] = src.canvas.summary()
-        if scene.has("poincare"):
-            meta["poincare"] = src.canvas.section.summary()
-        if voices:
-            meta["audio"] = voices.summary()
-        write_atomic(out_dir / "metadata.json", (json.dumps(meta, indent=2) + "\n").encode())
     return meta
 
 
