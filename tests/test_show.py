@@ -306,9 +306,10 @@ def test_window_keys_and_saved_frames(xvfb, reference, tmp_path):
 
         wid = wait_for("the window", window, proc)
         xdotool(xvfb, "key", "--window", wid, "--delay", "30", "space", "Right", "Right", "Right", "s")
-        first = wait_for("the first saved frame", lambda: sorted((out / "classic").glob("*.png")), proc)[0]
+        # --set: saved where `render` would write this scene, OUT/classic__<hash>/, not the preset's OUT/classic/
+        first = wait_for("the first saved frame", lambda: sorted(out.glob("classic__*/*.png")), proc)[0]
         xdotool(xvfb, "key", "--window", wid, "--delay", "30", "r", "Right", "Right", "s")
-        second = out / "classic" / "classic_frame_00002.png"
+        second = first.parent / f"{first.parent.name}_frame_00002.png"
         wait_for(second.name, second.exists, proc)
 
         # The window shows the frame itself: same orientation, same bytes (the loop blits after the keys).

@@ -66,15 +66,19 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
 
     s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",
                        description="Write t, the state (theta/omega or pos/vel) and energy at every frame time.")
-    s.add_argument("preset", metavar="PRESET")
-    s.add_argument("--out", type=Path, required=True, metavar="FILE.npz")
+    s.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
+    s.add_argument("--out", type=Path, required=True, metavar="FILE.npz",
+                   help="the trajectory file to write (its folder is made; written whole or not at all)")
     add_common(s)
     add_quality(s)
     add_budget(s)
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_simulate)
 
-    ls = sub.add_parser("presets", help="list the presets, one line each")
+    ls = sub.add_parser("presets", help="list the presets, one line each",
+                        description="List every preset on the search path ($PENDULUM_PRESETS, ./presets/, then "
+                                    "the shipped ones; the first of a name wins): its name, system and "
+                                    "description, one line each.")
     ls.set_defaults(func=cmd_presets)
 
     given = next((a for a in argv if not a.startswith("-")), None)  # before it come only flags (--debug, -h)
@@ -84,7 +88,8 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
         else:
             sub.add_parser(command, help=line)
     for command in sub.choices.values():  # --debug also after the command; main() reads it from argv
-        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                             help="on an error, print the traceback too (or set PENDULUM_DEBUG=1)")
     return p
 
 

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 from ..video import pipeline
-from ..config.options import add_common, add_quality, thread_count
+from ..config.options import add_common, add_quality, check_out_folder, output_name, thread_count
 from ..config.scene import load
 from .player import KEYS_HELP, FrameSource, Player, png_bytes, say  # noqa: F401 - png_bytes: show's PNG, for tests
 from .window import DISPLAY_TIMEOUT_S, Window, check_display  # noqa: F401 - the display timeout is show's to tell
@@ -94,11 +94,16 @@ def render_command(args) -> str:
         parts += ["--set", o]
     if args.quality:
         parts += ["--quality", args.quality]
+    if args.out != Path("out"):
+        parts += ["--out", str(args.out)]
     return shlex.join(parts)
 
 
 def run(args) -> int:
-    scene = load(args.preset, args.overrides, args.quality)
+    # frames saved with s go where `render` would write this scene: OUT/NAME__<hash>/ when overridden, and
+    # never through a symlink or into a file (checked before the window opens, as render checks)
+    scene = output_name(load(args.preset, args.overrides, args.quality), bool(args.overrides or args.quality))
+    check_out_folder(scene, args.out, files=())
     suggest = render_command(args)
     probe = check_display(suggest)  # before any compiling: a missing display fails at once
     try:

@@ -216,9 +216,10 @@ def check_out_folder(scene, out: Path, files: tuple[str, ...] | None = None):
 
 
 def check_replaceable(path: Path, what: str = "--out"):
-    """Bad input if `path` is a folder, or a file that is there and cannot be replaced by renaming a finished file onto it
-    (render/video/atomic.py), which would fail only after the work. Even root cannot replace an immutable or
-    append-only file (chattr +i, +a); no one but its owner, the folder's or root one in a sticky folder."""
+    """Bad input if `path` is a folder, or a file that is there and cannot be replaced by renaming a finished
+    file onto it (render/video/atomic.py), which would fail only after the work. Even root cannot replace an
+    immutable or append-only file (chattr +i, +a); no one but its owner, the folder's or root one in a sticky
+    folder."""
     try:
         st, folder = os.lstat(path), os.stat(Path(path).parent)
     except OSError:
