@@ -192,6 +192,37 @@ def test_a_publish_that_fails_names_the_file_asked_for_not_the_temporary(tmp_pat
     assert e.value.filename == str(tmp_path / "x.mp4") and str(tmp_path / "x.mp4") in str(e.value)
 
 
+def test_files_written_together_appear_together_or_not_at_all(tmp_path):
+    """atomic.together(), as accuracy, lyapunov and the gallery write: a chart finished before a failing table is
+    not left behind; when the block succeeds every file appears, in its final name only."""
+    from render.video import atomic
+    with pytest.raises(OSError):
+        with atomic.together():
+            atomic.write_atomic(tmp_path / "chart.png", b"png")
+            with atomic.replacing(tmp_path / "poster.jpg", suffix=".jpg") as tmp:
+                tmp.write_bytes(b"jpg")
+            assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
+            (tmp_path / "table.csv").mkdir()
+            atomic.write_atomic(tmp_path / "table.csv", b"csv")  # renamed onto a folder: fails at the end
+    assert [p.name for p in tmp_path.iterdir()] == ["table.csv"]  # only the folder that was there
+    (tmp_path / "table.csv").rmdir()
+    with atomic.together():
+        atomic.write_atomic(tmp_path / "chart.png", b"png")
+        atomic.write_atomic(tmp_path / "table.csv", b"csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["chart.png", "table.csv"]
+    atomic.write_atomic(tmp_path / "alone.txt", b"x")  # outside a block: published at once, as before
+    assert (tmp_path / "alone.txt").read_bytes() == b"x"
+
+
+def test_a_gallery_whose_page_is_a_folder_is_refused_before_any_poster(tmp_path):
+    r = run_cli("render", "classic", *TINY, "--name", "x", "--out", tmp_path / "out")
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "out" / "index.html").mkdir()
+    g = run_cli("gallery", "--out", tmp_path / "out")
+    assert g.returncode == 2 and len(g.stderr.strip().splitlines()) == 1 and "is a folder" in g.stderr, g.stderr
+    assert not list((tmp_path / "out" / "x").glob("*poster*"))
+
+
 def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
     (tmp_path / "p.toml").write_text(GOOD.format(name="p"))
     first = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)

@@ -19,7 +19,7 @@ from . import charts, flagship
 from ..trust import quality
 from ..physics import reference, registry
 from ..physics.stepper import Run
-from ..video.atomic import write_atomic
+from ..video.atomic import together, write_atomic
 from ..config.options import check_writable
 from ..config.limits import METHODS, PRECISIONS
 from ..config.scene import load
@@ -265,21 +265,22 @@ def run(args) -> int:
     rows.sort(key=lambda r: (systems.index(r["system"]), METHODS[r["system"]].index(r["method"]),
                              r["precision"] != "f64", -r["dt"]))
     args.out.mkdir(parents=True, exist_ok=True)
-    charts.accuracy_charts(args.out, rows, energy, chaos, {s: CASES[s] for s in systems}, UNITS, FPS, LONG_DT,
-                           CHAOS_FPS)
-    write_atomic(args.out / "accuracy.csv", csv_text(rows).encode())
-    # Timings share the CPU with whatever else runs: say how busy it was.
-    note = (f" Timed with {os.cpu_count()} CPU threads available, {args.arch}; 1-min load average "
-            f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after.")
-    md = md_text(rows, energy, args.quick, note)
-    if fan_rows:
-        scene = flagship.flagship(args.quick)
-        charts.flagship_charts(args.out, fan_rows, CHAOS, flagship.HORIZON, scene.video.duration,
-                               scene.pendulums.count)
-        md += "\n" + flagship.fan_md(fan_rows)
-        write_atomic(args.out / "quality.md", flagship.quality_md(quality_rows, args.quick).encode())
-    write_atomic(args.out / "accuracy.md", md.encode())
-    write_atomic(args.out / "summary.md", summary_md(rows, energy).encode())
+    with together():  # the charts and tables appear together: a failure leaves none of them
+        charts.accuracy_charts(args.out, rows, energy, chaos, {s: CASES[s] for s in systems}, UNITS, FPS, LONG_DT,
+                               CHAOS_FPS)
+        write_atomic(args.out / "accuracy.csv", csv_text(rows).encode())
+        # Timings share the CPU with whatever else runs: say how busy it was.
+        note = (f" Timed with {os.cpu_count()} CPU threads available, {args.arch}; 1-min load average "
+                f"{load0:.1f} before, {os.getloadavg()[0]:.1f} after.")
+        md = md_text(rows, energy, args.quick, note)
+        if fan_rows:
+            scene = flagship.flagship(args.quick)
+            charts.flagship_charts(args.out, fan_rows, CHAOS, flagship.HORIZON, scene.video.duration,
+                                   scene.pendulums.count)
+            md += "\n" + flagship.fan_md(fan_rows)
+            write_atomic(args.out / "quality.md", flagship.quality_md(quality_rows, args.quick).encode())
+        write_atomic(args.out / "accuracy.md", md.encode())
+        write_atomic(args.out / "summary.md", summary_md(rows, energy).encode())
     print(f"accuracy: {len(rows)} measurements in {time.perf_counter() - t0:.0f} s -> {args.out}/")
     return 0
 

@@ -26,9 +26,10 @@ from urllib.parse import quote
 from . import confined
 from ..trust import faithful
 from ..video import poster
-from ..video.atomic import digest, write_atomic
+from ..video.atomic import digest, together, write_atomic
 from ..errors import SceneError
 from ..config.limits import DESCRIPTION_MAX
+from ..config.options import check_replaceable
 from ..video.version import __version__
 
 CSS = """
@@ -118,10 +119,10 @@ def write_index(out_root: Path, failed: list[tuple[str, str]] = (), renders: lis
         items = "".join(f"<li><b>{_e(name)}</b>: {_e(err)}</li>" for name, err in failed)
         parts.append(f'<div class="failed"><b>Failed in the last batch</b><ul>{items}</ul></div>')
     parts.append('<div class="grid">')
-    parts += [card(r, r.folder.relative_to(root)) for r in renders]
-    parts.append(f"</div><script>{SCRIPT}</script></body></html>\n")
-    path = root / "index.html"
-    write_atomic(path, "\n".join(parts))
+    with together():  # the posters a card makes appear with the page, or not at all
+        parts += [card(r, r.folder.relative_to(root)) for r in renders]
+        parts.append(f"</div><script>{SCRIPT}</script></body></html>\n")
+        write_atomic(root / "index.html", "\n".join(parts))
     return shown / "index.html"
 
 
@@ -309,6 +310,7 @@ def run(args) -> int:
         tempfile.TemporaryFile(dir=root).close()
     except OSError as e:
         raise SceneError(f"--out {args.out}: cannot write the gallery there: {e.strerror}") from None
+    check_replaceable(root / "index.html")  # e.g. a folder of that name: refused before any poster is made
     renders = find_renders(root)
     index = write_index(args.out, renders=renders)
     skipped = sum(bool(r.skipped) for r in renders)

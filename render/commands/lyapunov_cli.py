@@ -58,7 +58,7 @@ def add_parser(sub):
 def run(args) -> int:
     from . import charts
     from ..trust import lyapunov
-    from ..video.atomic import replacing
+    from ..video.atomic import together, write_atomic
     from ..config.scene import load
 
     scene = output_name(load(args.preset, args.overrides), bool(args.overrides))
@@ -69,10 +69,10 @@ def run(args) -> int:
     doc, run_ = lyapunov.measure(scene, pendulums, args.arch, args.threads, progress_wanted(args))
     out_dir.mkdir(parents=True, exist_ok=True)
     png, js = (out_dir / f for f in FILES)
-    with replacing(js) as tmp:  # the numbers, then the chart, then the numbers published: a failure leaves neither
-        tmp.write_text(json.dumps(doc, indent=2) + "\n")
+    with together():  # the chart only with its numbers
         charts.lyapunov_chart(png, run_["t"], run_["running"], [int(i) for i in pendulums], scene.name,
                               doc["pendulums"][0]["checks"]["expected_sum"])
+        write_atomic(js, json.dumps(doc, indent=2) + "\n")
     for row in doc["pendulums"]:
         print(line(row))
     print(f"{scene.name}: {len(pendulums)} pendulum(s), {doc['pendulums'][0]['duration_s']:g} s, "

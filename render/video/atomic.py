@@ -7,6 +7,8 @@ exists; from another host sharing the folder (a Dask cluster), where liveness ca
 only after FOREIGN_STALE_S without a write. A live writer's file is never touched, and neither is a folder
 reached through a symlink at its end: that may lead out of the output folder, to files not ours to judge.
 """
+import contextvars
+import errno
 import hashlib
 import os
 import re
@@ -86,16 +88,55 @@ def publish(tmp: Path, path: Path):
         raise OSError(e.errno, e.strerror, str(path)) from e
 
 
+# The files finished within together()'s block, (temporary, final), in this thread or task; None outside one.
+_held: contextvars.ContextVar[list | None] = contextvars.ContextVar("held", default=None)
+
+
 @contextmanager
 def replacing(path: Path, suffix: str = ".part"):
-    """Yield a temporary path beside `path`; publish it onto `path` if the block succeeds, else remove it."""
+    """Yield a temporary path beside `path`; publish it onto `path` if the block succeeds (within together(),
+    when together()'s block does), else remove it."""
     tmp = temp_beside(path, suffix)
     try:
         yield tmp
-        publish(tmp, Path(path))
+        held = _held.get()
+        if held is None:
+            publish(tmp, Path(path))
+        else:
+            held.append((tmp, Path(path)))
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def together():
+    """A command's files appear together or not at all: within the block, each file replacing() and
+    write_atomic() finish stays in its temporary; all are published, in the order written, when the block
+    succeeds, and none is when it fails (their temporaries are removed). A chart written before a failing
+    table is not left behind without it."""
+    held: list[tuple[Path, Path]] = []
+    published: list[Path] = []
+    token = _held.set(held)
+    try:
+        yield
+        _held.reset(token)
+        token = None
+        for _, path in held:  # the one rename that fails in a folder we could write: onto a folder
+            if path.is_dir() and not path.is_symlink():
+                raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+        for tmp, path in held:
+            publish(tmp, path)
+            published.append(path)
+    except BaseException:
+        for tmp, _ in held:
+            tmp.unlink(missing_ok=True)
+        for path in published:  # a rename failed after these: this block's files appear together or not at all
+            path.unlink(missing_ok=True)
+        raise
+    finally:
+        if token is not None:
+            _held.reset(token)
 
 
 def write_atomic(path: Path, data: bytes | str):
