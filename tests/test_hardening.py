@@ -184,12 +184,17 @@ def test_a_render_that_fails_after_its_videos_are_finished_publishes_none_of_the
 
 
 def test_a_publish_that_fails_names_the_file_asked_for_not_the_temporary(tmp_path):
+    import errno
     from render.video import atomic
     (tmp_path / "x.mp4").mkdir()
     tmp = atomic.temp_beside(tmp_path / "x.mp4")
     with pytest.raises(IsADirectoryError) as e:
         atomic.publish(tmp, tmp_path / "x.mp4")
     assert e.value.filename == str(tmp_path / "x.mp4") and str(tmp_path / "x.mp4") in str(e.value)
+    with pytest.raises(OSError) as e:  # a write into the temporary that fails names no file: the final is named
+        with atomic.replacing(tmp_path / "y.json"):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert e.value.filename == str(tmp_path / "y.json") and not list(tmp_path.glob(".y.json*"))
 
 
 def test_files_written_together_appear_together_or_not_at_all(tmp_path):

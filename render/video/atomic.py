@@ -98,7 +98,8 @@ def replacing(path: Path, suffix: str = ".part"):
     when together()'s block does), else remove it."""
     tmp = temp_beside(path, suffix)
     try:
-        yield tmp
+        with naming(path):
+            yield tmp
         held = _held.get()
         if held is None:
             publish(tmp, Path(path))
@@ -106,6 +107,18 @@ def replacing(path: Path, suffix: str = ".part"):
             held.append((tmp, Path(path)))
     except BaseException:
         tmp.unlink(missing_ok=True)
+        raise
+
+
+@contextmanager
+def naming(path: Path):
+    """An OSError in the block that names no file (a write to an open file, on a full disk) names `path`, the
+    file the user asked for, and not our hidden temporary."""
+    try:
+        yield
+    except OSError as e:
+        if e.filename is None:
+            raise OSError(e.errno, e.strerror, str(path)) from e
         raise
 
 

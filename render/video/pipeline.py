@@ -14,7 +14,7 @@ from . import audio
 from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
-from .atomic import digest, publish, replacing, temp_beside
+from .atomic import digest, naming, publish, replacing, temp_beside
 from .version import __version__
 
 
@@ -159,7 +159,8 @@ def map_data(src, out_dir: Path) -> list[tuple[Path, Path]]:
     path = out_dir / f"{src.name}.npz"
     tmp = temp_beside(path, suffix=".npz")  # savez wants the .npz
     try:
-        np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
+        with naming(path):
+            np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
@@ -229,7 +230,8 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                 meta["poincare"] = src.canvas.section.summary()
             if voices:
                 meta["audio"] = voices.summary()
-            pending[-1][0].write_text(json.dumps(meta, indent=2) + "\n")
+            with naming(pending[-1][1]):
+                pending[-1][0].write_text(json.dumps(meta, indent=2) + "\n")
             enc.publish()
             for tmp, final in pending:
                 publish(tmp, final)
