@@ -170,6 +170,9 @@ def test_the_command_writes_the_spectrum_and_its_chart(tmp_path):
     (["damped_heavy", "--pendulums", "3,3"], "a pendulum named twice"),
     (["classic", "--set", "integrator.method=implicit_midpoint"], "integrator.method"),
     (["classic", "--set", "video.duration=0.1"], "video.duration"),
+    # many frames of few substeps: under the step cap, but their launches take hours (5 ms a frame)
+    (["classic", "--set", "video.duration=3000", "--set", "video.fps=240"], "over the run-time budget of 1 h"),
+    (["classic", "--set", "video.duration=300", "--budget", "60"], "over the run-time budget of 1 min"),
 ])
 def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, says):
     r = run_cli("lyapunov", *args, "--out", tmp_path / "out")

@@ -8,7 +8,10 @@ import argparse
 import json
 from pathlib import Path
 
-from ..config.options import add_common, check_out_folder, output_name, progress_wanted, thread_count
+from ..errors import SceneError
+from ..config import budget
+from ..config.options import (add_budget, add_common, budgeted, check_out_folder, output_name, progress_wanted,
+                              thread_count)
 
 FILES = ("lyapunov.png", "lyapunov.json")  # what it writes into OUT/NAME/
 
@@ -47,6 +50,7 @@ def add_parser(sub):
                                    "into OUT/NAME/.")
     p.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(p)
+    add_budget(p)
     p.add_argument("--pendulums", type=indices, metavar="I,J,...",
                    help="which pendulums, by index in the fan (default: the certificate's, at most 8)")
     p.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
@@ -61,9 +65,15 @@ def run(args) -> int:
     from ..video.atomic import together, write_atomic
     from ..config.scene import load
 
-    scene = output_name(load(args.preset, args.overrides), bool(args.overrides))
+    scene = budgeted(output_name(load(args.preset, args.overrides), bool(args.overrides)), args)
     pendulums = lyapunov.chosen(scene, args.pendulums)
     lyapunov.check(scene, pendulums)
+    est = lyapunov.seconds(scene, pendulums)
+    if est > budget.limit_s(scene):  # refused before it starts, as a render over its budget is
+        limit = budget.duration(budget.limit_s(scene))
+        raise SceneError(f"{scene.source}: video.duration: the spectrum is estimated at {budget.duration(est)} "
+                         f"({scene.frames} frames), over the run-time budget of {limit}; use a shorter "
+                         f"video.duration or a lower video.fps, or {budget.raise_by(est)}")
     check_out_folder(scene, args.out, FILES)  # a file, a symlink or a folder where these go: before the work
     out_dir = scene.out_dir(args.out)
     doc, run_ = lyapunov.measure(scene, pendulums, args.arch, args.threads, progress_wanted(args))

@@ -48,9 +48,10 @@ MOST = 128  # pendulums --pendulums may name
 BLOCKS = 10
 Z = 2.0  # the error reported is Z standard errors
 TANGENT_COST = 3  # a dual step costs about this many primal steps (the steps budget counts them)
-# The command's cap, not costed in time yet (render/config/budget.py costs renders): 1e11 pendulum-steps is about an
-# hour of rigid f64 RK4 at estimate.RATES.
+# The command's cap: 1e11 pendulum-steps is about an hour of rigid f64 RK4 at estimate.RATES, so that rate prices
+# them in time too (seconds()), with FRAME_S a frame, for `pendulum lyapunov`'s run-time budget.
 STEP_LIMIT = 10 ** 11
+STEP_RATE = STEP_LIMIT / 3600.0  # pendulum-steps a second (tangents included) for the time estimate
 FRAME_S = 5e-3  # the launches and QR of one frame, whatever the pendulums (measured 3-5 ms: see Cost above)
 
 
@@ -83,12 +84,22 @@ def check(scene, indices: np.ndarray):
     if scene.frames < 2 * BLOCKS + 1:
         raise SceneError(f"{scene.source}: video.duration: {scene.video.duration:g} s at {scene.video.fps} fps "
                          f"gives {scene.frames} frames; the spectrum's error needs at least {2 * BLOCKS + 1}")
-    plan = registry.get(scene.system)(scene, subset=indices[:1])
-    steps = scene.frames * plan.substeps * len(indices) * (1 + 2 * plan.D * TANGENT_COST)
+    steps = _steps(scene, indices)
     if steps > STEP_LIMIT:
         raise SceneError(f"{scene.source}: video.duration: the spectrum needs about {steps:.3g} "
                          f"pendulum-steps (tangent vectors included), beyond the budget of "
                          f"{STEP_LIMIT:.0e}; use fewer --pendulums or a shorter video.duration")
+
+
+def _steps(scene, indices: np.ndarray) -> float:
+    plan = registry.get(scene.system)(scene, subset=indices[:1])
+    return scene.frames * plan.substeps * len(indices) * (1 + 2 * plan.D * TANGENT_COST)
+
+
+def seconds(scene, indices: np.ndarray) -> float:
+    """The spectrum's estimated run time: its steps at STEP_RATE, and each frame's launches (FRAME_S), which
+    are most of it where many frames have few substeps."""
+    return _steps(scene, indices) / STEP_RATE + scene.frames * FRAME_S
 
 
 def error(rates: np.ndarray) -> np.ndarray:
