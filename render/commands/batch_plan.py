@@ -30,7 +30,10 @@ def expand_refs(refs: list[str]) -> list[str]:
             preset_path(ref)  # a missing preset is a bad command line (exit 2), not a failed render
             out.append(ref)
         elif "/" in ref or ref.endswith(".toml"):
-            out += sorted(glob.glob(ref)) or _no_match(ref)
+            matches = sorted(glob.glob(ref)) or _no_match(ref)
+            for match in matches:  # each must be a preset file, as a path given outright must: a FIFO is none
+                preset_path(match)
+            out += matches
         else:
             out += [str(p) for p in list_presets() if fnmatch.fnmatchcase(p.stem, ref)] or _no_match(ref)
     return list(dict.fromkeys(out))

@@ -8,7 +8,8 @@ symlink out of OUT. So nothing here follows a symlink: a folder is taken only wh
 at every step below the root, a file only when it is a regular one, opened with O_NOFOLLOW | O_NONBLOCK and
 checked with fstat before a byte is read, and a file name from metadata only when it is one plain name in its
 own folder. Whatever is refused raises Refused, whose message says why in a few words, for the card that
-shows it (render/commands/gallery.py).
+shows it (render/commands/gallery.py). A preset is read the same way (read_regular), symlinks followed: a user's
+preset may be a link, but a FIFO or /dev/zero given as one must not hang the command or fill memory.
 """
 from __future__ import annotations
 
@@ -39,7 +40,7 @@ def folder(root: Path, path: Path) -> Path:
             raise Refused(f"{here.name} is a symlink (to {_short(os.readlink(here))}), and only what is inside "
                           f"the output folder is read")
         if not stat.S_ISDIR(mode):
-            raise Refused(f"{here.name} is {_kind(mode)}, not a folder")
+            raise Refused(f"{here.name} is {kind(mode)}, not a folder")
     return Path(path)
 
 
@@ -56,36 +57,47 @@ def member(where: Path, name) -> Path | None:
     except OSError as e:  # e.g. a name over the file system's 255 bytes
         raise Refused(f"outputs {_short(name)!r}: {e.strerror}") from None
     if not stat.S_ISREG(mode):
-        raise Refused(f"outputs {_short(name)!r} is {_kind(mode)}, not a regular file")
+        raise Refused(f"outputs {_short(name)!r} is {kind(mode)}, not a regular file")
     return path
+
+
+def read_regular(path: Path, limit: int, follow: bool = True) -> bytes:
+    """The bytes of `path`, a regular file of at most `limit` bytes; Refused otherwise, its message what the
+    file is ("a FIFO, not a regular file") for the caller to put after the file's name; OSError when it cannot
+    be opened at all. With follow=False a symlink is not opened (OSError ELOOP)."""
+    flags = os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC | (0 if follow else os.O_NOFOLLOW)
+    fd = os.open(path, flags)  # O_NONBLOCK: opening a FIFO returns at once instead of waiting for a writer
+    try:
+        st = os.fstat(fd)  # of what was opened: a file swapped in after a stat of the path is still caught
+        if not stat.S_ISREG(st.st_mode):
+            raise Refused(f"{kind(st.st_mode)}, not a regular file")
+        if st.st_size > limit:
+            raise Refused(f"{st.st_size} bytes, over the {limit}-byte limit")
+        chunks, size = [], 0  # read to the end, one byte past the cap at most: it may have grown since fstat
+        while size <= limit and (chunk := os.read(fd, limit + 1 - size)):
+            chunks.append(chunk)
+            size += len(chunk)
+    finally:
+        os.close(fd)
+    if size > limit:
+        raise Refused(f"over the {limit}-byte limit")
+    return b"".join(chunks)
 
 
 def read_json(path: Path):
     """The parsed JSON of `path`, a regular file of at most META_MAX_BYTES; Refused otherwise (OSError
     when it cannot be opened at all)."""
     path = Path(path)
-    try:  # O_NONBLOCK: opening a FIFO returns at once instead of waiting for a writer, and fstat then tells
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    try:
+        data = read_regular(path, META_MAX_BYTES, follow=False)
+    except Refused as e:
+        raise Refused(f"{path.name} is {e}") from None
     except OSError:
         if os.path.islink(path):  # O_NOFOLLOW's ELOOP
             raise Refused(f"{path.name} is a symlink (to {_short(os.readlink(path))}), not a file") from None
         raise
     try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise Refused(f"{path.name} is {_kind(st.st_mode)}, not a regular file")
-        if st.st_size > META_MAX_BYTES:
-            raise Refused(f"{path.name} is {st.st_size} bytes, over the {META_MAX_BYTES}-byte limit")
-        chunks, size = [], 0  # read to the end, one byte past the cap at most: it may have grown since fstat
-        while size <= META_MAX_BYTES and (chunk := os.read(fd, META_MAX_BYTES + 1 - size)):
-            chunks.append(chunk)
-            size += len(chunk)
-    finally:
-        os.close(fd)
-    if size > META_MAX_BYTES:
-        raise Refused(f"{path.name} is over the {META_MAX_BYTES}-byte limit")
-    try:
-        return json.loads(b"".join(chunks), parse_int=_int)
+        return json.loads(data, parse_int=_int)
     except RecursionError:
         raise Refused(f"{path.name} is nested too deeply to parse") from None
     except ValueError as e:  # UnicodeDecodeError included
@@ -116,7 +128,7 @@ def _int(text: str) -> int:
     return int(text)
 
 
-def _kind(mode: int) -> str:
+def kind(mode: int) -> str:
     kinds = {stat.S_ISDIR: "a folder", stat.S_ISFIFO: "a FIFO", stat.S_ISCHR: "a device", stat.S_ISBLK: "a device",
              stat.S_ISSOCK: "a socket", stat.S_ISLNK: "a symlink", stat.S_ISREG: "a file"}
     return next((what for test, what in kinds.items() if test(mode)), "not a file")

@@ -16,10 +16,14 @@ import os
 import stat
 from pathlib import Path
 
+from ..commands.confined import kind
 from ..errors import SceneError
 from .checks import hint
 
 ENV = "PENDULUM_PRESETS"
+# The most a preset file may hold. The largest shipped one is about 1 kB; a file over 1 MiB is no preset (a
+# wrong path, a log, /dev/zero behind a link), and reading it whole would only fill memory.
+PRESET_MAX_BYTES = 1 << 20
 
 
 def shipped_dir() -> Path:
@@ -50,16 +54,18 @@ def search_path() -> list[Path]:
 
 
 def _there(path: Path, what: str = "", folder: bool = False) -> bool:
-    """Whether `path` exists (a folder, or a file); SceneError naming it and the OS's reason when it cannot
-    be looked at or is the wrong kind. pathlib's is_dir() and is_file() say False to a symlink loop."""
+    """Whether `path` exists (a folder, or a regular file); SceneError naming it and the OS's reason when it
+    cannot be looked at or is the wrong kind. pathlib's is_dir() and is_file() say False to a symlink loop."""
     try:
-        is_dir = stat.S_ISDIR(path.stat().st_mode)
+        mode = path.stat().st_mode
     except (FileNotFoundError, NotADirectoryError):  # not there, or a file where a folder of its path is
         return False
     except OSError as e:
         raise SceneError(f"{what}{path}: {e.strerror or e}") from None
-    if is_dir != folder:
+    if stat.S_ISDIR(mode) != folder:
         raise SceneError(f"{what}{path}: {os.strerror(errno.ENOTDIR if folder else errno.EISDIR)}")
+    if not folder and not stat.S_ISREG(mode):  # a FIFO's read waits for a writer, a device's may never end
+        raise SceneError(f"{what}{path}: {kind(mode)}, not a regular file")
     return True
 
 

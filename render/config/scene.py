@@ -13,7 +13,8 @@ import tomllib
 from pathlib import Path
 
 from ..physics import keys, registry
-from .catalog import PRESET_DIR, list_presets, preset_path  # noqa: F401 - where presets are found
+from ..commands.confined import Refused, read_regular
+from .catalog import PRESET_DIR, PRESET_MAX_BYTES, list_presets, preset_path  # noqa: F401 - where presets are found
 from ..errors import SceneError
 from ..trust.levels import check_level
 from .checks import clip, hint
@@ -225,7 +226,9 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
     path = preset_path(ref)
     src = _display(path)
     try:
-        raw = tomllib.loads(path.read_text())
+        raw = tomllib.loads(read_regular(path, PRESET_MAX_BYTES).decode())  # never blocks, never reads past the cap
+    except Refused as e:  # over the cap, or no longer a regular file since preset_path looked
+        raise SceneError(f"{src}: {e}") from None
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{src}: malformed TOML: {e}") from None
     except RecursionError:  # tomllib recurses once per level of nested arrays or inline tables
