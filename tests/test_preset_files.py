@@ -86,3 +86,13 @@ def test_a_fifo_on_the_search_path(tmp_path):
     rows = {line.split()[0]: line for line in r.stdout.splitlines()}
     assert "INVALID" in rows["classic"] and f"{folder / 'classic.toml'}: {FIFO}" in rows["classic"]
     assert "INVALID" not in rows["fractal"]  # the others are still listed, and read
+
+
+def test_a_fifo_where_the_bench_rates_go_is_ignored_not_waited_on(tmp_path):
+    """OUT/bench/rates.json, which the budget reads before a render, may be anything a user put there: a FIFO
+    is passed over for the built-in rates (as a malformed file is), and the render runs."""
+    (tmp_path / "out" / "bench").mkdir(parents=True)
+    os.mkfifo(tmp_path / "out" / "bench" / "rates.json")
+    r = cli(tmp_path, "render", "classic", "--set", "video.duration=0.1", "--set", "video.width=64", "--set",
+            "video.height=36", "--no-progress", "--out", tmp_path / "out")
+    assert r.returncode == 0, r.stderr

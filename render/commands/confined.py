@@ -8,7 +8,7 @@ symlink out of OUT. So nothing here follows a symlink: a folder is taken only wh
 at every step below the root, a file only when it is a regular one, opened with O_NOFOLLOW | O_NONBLOCK and
 checked with fstat before a byte is read, and a file name from metadata only when it is one plain name in its
 own folder. Whatever is refused raises Refused, whose message says why in a few words, for the card that
-shows it (render/commands/gallery.py). A preset is read the same way (read_regular), symlinks followed: a user's
+shows it (render/commands/gallery.py). A preset is read the same way (render/config/files.py), symlinks followed: a user's
 preset may be a link, but a FIFO or /dev/zero given as one must not hang the command or fill memory.
 """
 from __future__ import annotations
@@ -18,15 +18,13 @@ import os
 import stat
 from pathlib import Path
 
+from ..config.files import Refused, kind, read_regular
+
 META_MAX_BYTES = 1 << 20  # 1 MiB; a render's metadata.json is a few kB (a histogram replaces long per-pendulum lists)
 INT_DIGITS_MAX = 18  # every count and byte size a render records fits in int64; 10**400 fits no float
 # The sections a card reads, and the type each must have when present (metadata from older versions may lack some).
 SECTIONS = {"preset": dict, "integrator": dict, "energy": dict, "timings_s": dict, "versions": dict,
             "faithfulness": dict, "outputs": dict, "outputs_sha256": dict}
-
-
-class Refused(ValueError):
-    """A folder or file under OUT that is not read; the message says why."""
 
 
 def folder(root: Path, path: Path) -> Path:
@@ -59,29 +57,6 @@ def member(where: Path, name) -> Path | None:
     if not stat.S_ISREG(mode):
         raise Refused(f"outputs {_short(name)!r} is {kind(mode)}, not a regular file")
     return path
-
-
-def read_regular(path: Path, limit: int, follow: bool = True) -> bytes:
-    """The bytes of `path`, a regular file of at most `limit` bytes; Refused otherwise, its message what the
-    file is ("a FIFO, not a regular file") for the caller to put after the file's name; OSError when it cannot
-    be opened at all. With follow=False a symlink is not opened (OSError ELOOP)."""
-    flags = os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC | (0 if follow else os.O_NOFOLLOW)
-    fd = os.open(path, flags)  # O_NONBLOCK: opening a FIFO returns at once instead of waiting for a writer
-    try:
-        st = os.fstat(fd)  # of what was opened: a file swapped in after a stat of the path is still caught
-        if not stat.S_ISREG(st.st_mode):
-            raise Refused(f"{kind(st.st_mode)}, not a regular file")
-        if st.st_size > limit:
-            raise Refused(f"{st.st_size} bytes, over the {limit}-byte limit")
-        chunks, size = [], 0  # read to the end, one byte past the cap at most: it may have grown since fstat
-        while size <= limit and (chunk := os.read(fd, limit + 1 - size)):
-            chunks.append(chunk)
-            size += len(chunk)
-    finally:
-        os.close(fd)
-    if size > limit:
-        raise Refused(f"over the {limit}-byte limit")
-    return b"".join(chunks)
 
 
 def read_json(path: Path):
@@ -126,12 +101,6 @@ def _int(text: str) -> int:
     if len(text.lstrip("-")) > INT_DIGITS_MAX:
         raise ValueError(f"an integer of {len(text.lstrip('-'))} digits, more than any count or size")
     return int(text)
-
-
-def kind(mode: int) -> str:
-    kinds = {stat.S_ISDIR: "a folder", stat.S_ISFIFO: "a FIFO", stat.S_ISCHR: "a device", stat.S_ISBLK: "a device",
-             stat.S_ISSOCK: "a socket", stat.S_ISLNK: "a symlink", stat.S_ISREG: "a file"}
-    return next((what for test, what in kinds.items() if test(mode)), "not a file")
 
 
 def _json_kind(value) -> str:

@@ -16,7 +16,7 @@ import os
 import stat
 from pathlib import Path
 
-from ..commands.confined import kind
+from .files import kind
 from ..errors import SceneError
 from .checks import hint
 

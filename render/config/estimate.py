@@ -26,8 +26,10 @@ from ..trust import certify, quality
 from ..physics import grid, registry
 from ..physics.integrators import METHOD
 from ..physics.keys import DRAWN
+from .files import read_regular
 
 RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
+RATES_MAX_BYTES = 1 << 20  # the bench writes about 2 kB
 # The FTLE map (render/maps/ftle.py) steps each point with its 2D tangent vectors beside it, as duals: its advance
 # took 3.25 times the plain advance of the same points (fractal_lyapunov at 720p, 381,924 points, 17 RK4 substeps:
 # 184.1 against 56.6 ms, medians of 5 alternating rounds, 2-core Xeon with AVX-512, 2026-12-06, a script not kept)
@@ -95,9 +97,9 @@ def load_rates(out: Path | None) -> tuple[dict, str]:
     JSON table: a malformed file is ignored, never an error)."""
     rates = json.loads(json.dumps(RATES))
     path = Path(out) / RATES_FILE if out is not None else None
-    try:
-        given = json.loads(path.read_text()) if path is not None else None
-    except (OSError, ValueError):  # absent, unreadable, not UTF-8 or not JSON
+    try:  # read as a preset is: a FIFO or /dev/zero there must not hang the check or fill memory
+        given = json.loads(read_regular(path, RATES_MAX_BYTES)) if path is not None else None
+    except (OSError, ValueError):  # absent, unreadable, not a regular file (Refused), not UTF-8 or not JSON
         given = None
     used = 0
     for key, default in RATES.items() if isinstance(given, dict) else ():
