@@ -228,6 +228,23 @@ def test_a_gallery_whose_page_is_a_folder_is_refused_before_any_poster(tmp_path)
     assert not list((tmp_path / "out" / "x").glob("*poster*"))
 
 
+def test_a_render_removes_the_files_of_an_earlier_render_it_does_not_write_again(tmp_path):
+    """OUT/NAME holds one render: the GIF an earlier render listed in its metadata.json goes when the next one,
+    its formats changed, writes no GIF; a file of another kind, or one the old metadata did not list, stays."""
+    def render(*formats):
+        r = run_cli("render", "classic", *TINY, "--set", f"video.formats={list(formats)!r}".replace("'", '"'),
+                    "--name", "x", "--out", tmp_path)
+        assert r.returncode == 0, r.stderr
+        return sorted(p.name for p in (tmp_path / "x").iterdir())
+
+    assert render("mp4", "gif") == ["metadata.json", "x.gif", "x.mp4"]
+    (tmp_path / "x" / "x.webm").write_text("mine")
+    (tmp_path / "x" / "x.png").write_text("mine too: not in the metadata")
+    assert render("mp4") == ["metadata.json", "x.mp4", "x.png", "x.webm"]
+    assert (tmp_path / "x" / "x.png").read_text() == "mine too: not in the metadata"
+    assert render("gif") == ["metadata.json", "x.gif", "x.png", "x.webm"]
+
+
 def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
     (tmp_path / "p.toml").write_text(GOOD.format(name="p"))
     first = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)

@@ -8,7 +8,7 @@ symlink out of OUT. So nothing here follows a symlink: a folder is taken only wh
 at every step below the root, a file only when it is a regular one, opened with O_NOFOLLOW | O_NONBLOCK and
 checked with fstat before a byte is read, and a file name from metadata only when it is one plain name in its
 own folder. Whatever is refused raises Refused, whose message says why in a few words, for the card that
-shows it (render/commands/gallery.py). A preset is read the same way (render/config/files.py), symlinks followed: a user's
+shows it (render/commands/gallery.py). A preset is read the same way (render/video/files.py), symlinks followed: a user's
 preset may be a link, but a FIFO or /dev/zero given as one must not hang the command or fill memory.
 """
 from __future__ import annotations
@@ -18,7 +18,7 @@ import os
 import stat
 from pathlib import Path
 
-from ..config.files import Refused, kind, read_regular
+from ..video.files import Refused, kind, read_regular
 
 META_MAX_BYTES = 1 << 20  # 1 MiB; a render's metadata.json is a few kB (a histogram replaces long per-pendulum lists)
 INT_DIGITS_MAX = 18  # every count and byte size a render records fits in int64; 10**400 fits no float

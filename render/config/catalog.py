@@ -16,7 +16,7 @@ import os
 import stat
 from pathlib import Path
 
-from .files import kind
+from ..video.files import kind
 from ..errors import SceneError
 from .checks import hint
 

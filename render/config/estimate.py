@@ -26,7 +26,7 @@ from ..trust import certify, quality
 from ..physics import grid, registry
 from ..physics.integrators import METHOD
 from ..physics.keys import DRAWN
-from .files import read_regular
+from ..video.files import read_regular
 
 RATES_FILE = Path("bench") / "rates.json"  # under the run's OUT
 RATES_MAX_BYTES = 1 << 20  # the bench writes about 2 kB

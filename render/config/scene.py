@@ -13,7 +13,7 @@ import tomllib
 from pathlib import Path
 
 from ..physics import keys, registry
-from .files import Refused, read_regular
+from ..video.files import Refused, read_regular
 from .catalog import PRESET_DIR, PRESET_MAX_BYTES, list_presets, preset_path  # noqa: F401 - where presets are found
 from ..errors import SceneError
 from ..trust.levels import check_level

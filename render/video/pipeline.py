@@ -15,8 +15,12 @@ from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
 from .atomic import digest, naming, publish, replacing, temp_beside
+from .files import read_regular
 from .version import __version__
 
+
+OUTPUTS = ("mp4", "gif", "png", "npz")  # the kinds of file a render writes beside metadata.json (superseded())
+META_MAX_BYTES = 1 << 20  # an earlier render's metadata.json is a few kB
 
 def prepare(scene, arch: str, threads: int | None):
     """Before the first frame: the integrator a --quality level calls for, and its faithfulness certificate,
@@ -167,6 +171,20 @@ def map_data(src, out_dir: Path) -> list[tuple[Path, Path]]:
     return [(tmp, path)]
 
 
+def superseded(out_dir: Path, name: str, now: dict) -> list[Path]:
+    """The files an earlier render into this folder listed in its metadata.json and this one does not write (a
+    GIF, after `formats` dropped it): removed once the new metadata is published, so that the folder holds one
+    render. Only its own kind of file, NAME.<format or npz>, a regular file; an unreadable old metadata.json names
+    nothing."""
+    try:
+        old = json.loads(read_regular(out_dir / "metadata.json", META_MAX_BYTES, follow=False)).get("outputs")
+    except (OSError, ValueError, AttributeError):  # none, not ours to read (Refused is a ValueError), not a table
+        return []
+    ours = {f"{name}.{ext}" for ext in OUTPUTS}
+    return [out_dir / f for f in (old if isinstance(old, dict) else ()) if f in ours and f not in now
+            and (out_dir / f).is_file() and not (out_dir / f).is_symlink()]
+
+
 def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, threads: int | None = None,
            frame_hook=None, cluster=None, bands: int | None = None) -> dict:
     """Render scene into out_root/NAME/ (a comparison into out_root/compare/NAME/); returns the metadata it
@@ -232,9 +250,12 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
                 meta["audio"] = voices.summary()
             with naming(pending[-1][1]):
                 pending[-1][0].write_text(json.dumps(meta, indent=2) + "\n")
+            stale = superseded(out_dir, scene.name, sizes)
             enc.publish()
             for tmp, final in pending:
                 publish(tmp, final)
+            for path in stale:
+                path.unlink(missing_ok=True)
         except BaseException:
             enc.abort()
             for tmp, _ in pending:

@@ -1,7 +1,8 @@
 """Reading a file the user names, or that an output folder holds, without trusting what it is: only a regular
 file is read, never past a size cap, and opening it never blocks (a FIFO given as a preset hung the command,
 /dev/zero filled the machine's memory). Presets are read this way (render/config/scene.py, catalog.py), and the
-output folder's metadata.json files (render/commands/confined.py, which adds what it takes from them).
+output folder's metadata.json files (render/commands/confined.py, which adds what it takes from them;
+render/video/pipeline.py's superseded()). It sits beside atomic.py, which writes them, below every layer that reads.
 """
 from __future__ import annotations
 
