@@ -232,7 +232,7 @@ class SplitScreen:
 
     # ------------------------------------------------------------ metadata
     def run_meta(self) -> dict:
-        """What metadata.json says of the simulation (pipeline.metadata), as pipeline.record says it of one
+        """What metadata.json says of the simulation (render/video/metadata.py), as pipeline.record says it of one
         run: the finest variant's integrator, certificate and quality, the largest energy drift of any
         variant, every variant's kernels."""
         ref = self.runs[self.ref]
