@@ -237,7 +237,8 @@ BAD = [
     (["--vary", "integrator.dt=1e-3,-1"], ["rigid_chaos.toml", "variant 2", "integrator.dt", "> 0"]),
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3"], ["--vary integrator.dt", "1 value"]),
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3,2e-3,3e-3"], ["paired"]),
-    (["--vary", "integrator.dt=1e-3,1e-3"], ["--vary integrator.dt", "twice"]),
+    (["--vary", "integrator.dt=1e-3,1e-3"], ["compare.vary", "the same variant"]),
+    (["--vary", "integrator.method=rk2,rk4,rk2", "--vary", "integrator.dt=1e-3,1e-3,1e-3"], ["the same variant"]),
     ([], ["rigid_chaos.toml", "compare", "no [compare] table", "--vary"]),
 ]
 
@@ -249,6 +250,17 @@ def test_bad_comparisons_exit_2_with_one_line_and_write_nothing(tmp_path, args, 
     assert code == 2 and len(lines) == 1, err
     assert all(n in lines[0] for n in needles), lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_a_grid_of_two_keys_repeats_each_value_and_is_four_distinct_panels():
+    """docs/comparisons.md's 2×2: paired --vary lists repeat values (rk2 twice, f32 twice); only panels that are
+    the same as a whole are refused (above)."""
+    from render.commands import api
+    from render.config.scene import load
+    scene = api.with_vary(load("rigid_chaos"), ["integrator.method=rk2,rk2,rk4,rk4",
+                                                "integrator.precision=f32,f64,f32,f64"])
+    assert [(v.integrator.method, v.integrator.precision) for v in scene.variants()] == [
+        ("rk2", "f32"), ("rk2", "f64"), ("rk4", "f32"), ("rk4", "f64")]
 
 
 @pytest.mark.parametrize("table, needles", [

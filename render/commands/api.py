@@ -177,7 +177,7 @@ def with_vary(scene, items: list[str]):
         if why:
             raise SceneError(f"--vary {key}: cannot vary: {why}; {VARYING}")
     vary = {}
-    for key, vals in batch_plan.parse_sweeps(items, "--vary"):
+    for key, vals in batch_plan.parse_sweeps(items, "--vary", distinct=False):
         if key in vary:
             raise SceneError(f"--vary {key}: given twice; list every value in one --vary")
         lo, hi = VARIANTS

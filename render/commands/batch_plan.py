@@ -56,9 +56,12 @@ def check_key(key: str, what: str):
         raise SceneError(f"{what} {key}: is a section; give a key inside it")
 
 
-def parse_sweeps(items: list[str], what: str = "--sweep") -> list[tuple[str, list[tuple[str, str]]]]:
+def parse_sweeps(items: list[str], what: str = "--sweep",
+                 distinct: bool = True) -> list[tuple[str, list[tuple[str, str]]]]:
     """['k=a,b'] -> [('k', [(raw 'a', name text 'a'), ...])]; `what` names the option in errors (`compare`
-    parses its --vary lists here too)."""
+    parses its --vary lists here too). distinct: a value listed twice is refused, as a crossed sweep would make
+    that variant twice; paired --vary lists repeat values in a grid (rk2,rk2,rk4,rk4 beside f32,f64,f32,f64),
+    and a comparison refuses only panels that are the same as a whole."""
     sweeps = []
     for item in items:
         key, sep, values = item.partition("=")
@@ -72,7 +75,7 @@ def parse_sweeps(items: list[str], what: str = "--sweep") -> list[tuple[str, lis
         for raw in _split_top(values, what):
             _, value = parse_override(f"{key}={raw}", what)
             vals.append((raw, _sanitize(_text(value))))
-        if len({t for _, t in vals}) != len(vals):
+        if distinct and len({t for _, t in vals}) != len(vals):
             raise SceneError(f"{what} {key}: lists a value twice")
         sweeps.append((key, vals))
     return sweeps
