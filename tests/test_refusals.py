@@ -119,6 +119,21 @@ def test_lyapunov_into_a_folder_that_is_a_symlink_out_of_out_is_refused_up_front
     assert tree(elsewhere) == []
 
 
+
+def test_a_bad_scheduler_from_the_environment_is_refused_before_the_first_render(tmp_path):
+    """$DASK_SCHEDULER_ADDRESS tiles the maps of a `render`: checked, and named, before any preset renders (a
+    fan before the map was rendered first); an empty --scheduler is refused, not taken as none."""
+    out = tmp_path / "out"
+    r = cli(tmp_path, "render", "classic", "fractal_flip", *SMALL, "--out", out,
+            env={"DASK_SCHEDULER_ADDRESS": "tcp://host:abc"})
+    refused(r, tmp_path, "$DASK_SCHEDULER_ADDRESS 'tcp://host:abc'", "expected an address")
+    r = cli(tmp_path, "render", "fractal_flip", *SMALL, "--scheduler", "", "--out", out)
+    refused(r, tmp_path, "--scheduler ''")
+    r = cli(tmp_path, "render", "classic", *SMALL, "--out", "")
+    assert r.returncode == 2 and "--out: must name a folder or file" in r.stderr, r.stderr
+    assert not out.exists() and tree(tmp_path) == []
+
+
 # ------------------------------------------------------------------ 3. outputs even root cannot write
 def test_simulate_onto_an_immutable_file_is_refused_up_front(tmp_path):
     target = tmp_path / "t.npz"

@@ -22,8 +22,8 @@ from . import batch_plan
 from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
-from ..config.options import (check_arch, check_out_folder, check_replaceable, check_threads, check_tiles,
-                              check_writable, usable_cores)
+from ..config.options import (check_arch, check_out, check_out_folder, check_replaceable, check_threads,
+                              check_tiles, check_writable, usable_cores)
 from ..config.vary import VARIANTS, VARYING, vary_refusal
 from .results import RenderResult, Trajectory
 
@@ -91,7 +91,7 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
     from ..video import tiled
 
     scene = _scene(scene)
-    arch, threads, out = check_arch(arch), check_threads(threads), Path(out)
+    arch, threads, out = check_arch(arch), check_threads(threads), check_out(out)
     address, tiles = tiled.scheduler_address(scheduler), check_tiles(tiles)
     how = "--scheduler" if address else "--tiles" if tiles else None
     check_render([scene], out, how)
@@ -123,7 +123,7 @@ def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
     """Simulate a Scene (or a preset name) without drawing: the state at every frame time, as the .npz of
     `pendulum simulate` holds it. Nothing is written unless `out` names a .npz file."""
     scene, arch = _scene(scene), check_arch(arch)
-    out = Path(out) if out is not None else None
+    out = check_out(out) if out is not None else None
     if out is not None:
         check_npz(out, scene.name)
     budget.check(scene, registry.get(scene.system), out.parent if out is not None else None, simulate=True)

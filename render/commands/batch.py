@@ -24,7 +24,7 @@ from ..physics import registry
 from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
-                              positive_int, progress_wanted, thread_count, usable_cores)
+                              out_path, positive_int, progress_wanted, thread_count, usable_cores)
 from ..video.tiled import connect, scheduler_address
 from ..video.version import __version__
 
@@ -39,10 +39,10 @@ def add_parser(sub):
     b.add_argument("presets", nargs="*", metavar="PRESET|GLOB",
                    help="preset names, .toml paths or globs of either (default: every file in presets/)")
     add_common(b)
-    b.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    b.add_argument("--out", type=out_path, default=Path("out"), help="output root (default: out)")
     b.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="J",
                    help="local worker processes (default: the number of cores)")
-    b.add_argument("--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
+    b.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="run on this Dask scheduler, e.g. tcp://host:8786 (default: $DASK_SCHEDULER_ADDRESS); "
                         "--out must then be a directory the workers share")
     b.add_argument("--force", action="store_true", help="render again even when the output is up to date")
@@ -141,7 +141,8 @@ def run_dask(scenes, out_root, address, arch, threads, digest):
 
 def run(args) -> int:
     t0 = time.perf_counter()
-    address = scheduler_address(args.scheduler)
+    address = scheduler_address(args.scheduler) if args.scheduler is not None else \
+        scheduler_address(os.environ.get("DASK_SCHEDULER_ADDRESS"), "$DASK_SCHEDULER_ADDRESS")
     jobs_plan = plan(expand_refs(args.presets), args.overrides, parse_sweeps(args.sweep), args.quality)
     check_writable(args.out)
     out_root = args.out.resolve()  # absolute: Dask workers may run elsewhere with another cwd

@@ -27,7 +27,7 @@ from .bench_process import maxrss_mb, run_phase
 from .bench_sim import phase_sim
 from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
 from ..video.atomic import write_atomic
-from ..config.options import check_writable, positive_int
+from ..config.options import check_writable, out_path, positive_int
 from ..physics import vector_width
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
@@ -62,7 +62,7 @@ def add_parser(sub):
                                    "from which `render --out DIR` estimates its run time when they are "
                                    "DIR/bench/rates.json (the default out/bench serves the default out).")
     p.add_argument("--quick", action="store_true", help="small N ladder, short videos, 2 rounds (a few minutes)")
-    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
+    p.add_argument("--out", type=out_path, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend (default: cpu)")
     p.add_argument("--repeat", type=lambda t: positive_int(t, MAX_ROUNDS), metavar="R",
                    help=f"interleaved rounds of each comparison with a peer, and the number of timed "

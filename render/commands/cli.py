@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..errors import BatchError, EncodeError, SceneError, SimulationError
 from ..config.options import (add_budget, add_common, add_quality, add_render_options, add_tiles, budgeted, output_name,
-                              progress_wanted)
+                              out_path, progress_wanted)
 
 # Subcommands living in their own modules: command -> (module, the line `pendulum --help` lists it with). Each
 # module has add_parser(subparsers) and run(args) -> exit code. Only the module of the command given is imported:
@@ -67,7 +67,7 @@ def build_parser(argv=()) -> argparse.ArgumentParser:
     s = sub.add_parser("simulate", help="simulate without drawing; write the state at every frame to .npz",
                        description="Write t, the state (theta/omega or pos/vel) and energy at every frame time.")
     s.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
-    s.add_argument("--out", type=Path, required=True, metavar="FILE.npz",
+    s.add_argument("--out", type=out_path, required=True, metavar="FILE.npz",
                    help="the trajectory file to write (its folder is made; written whole or not at all)")
     add_common(s)
     add_quality(s)
@@ -102,6 +102,9 @@ def load_preset(preset: str, args):
     return budgeted(load(preset, args.overrides, args.quality), args)
 
 
+ENV_SCHEDULER = "DASK_SCHEDULER_ADDRESS"  # Dask's own variable: the cluster a map renders on without --scheduler
+
+
 def cmd_render(args) -> int:
     from ..video.tiled import scheduler_address
 
@@ -114,14 +117,18 @@ def cmd_render(args) -> int:
     from . import api
     from ..config import budget
 
-    tiled = "--scheduler" if address else "--tiles" if args.tiles else None
-    api.check_render(scenes, args.out, tiled)  # every scene's refusals before the first render
+    # as for `batch`, Dask's own variable names the cluster: for the maps, which alone can be tiled; checked, with
+    # what it asks of each map, before the first render as --scheduler is
+    env = ENV_SCHEDULER if not address and any(s.fractal for s in scenes) else None
+    from_env = scheduler_address(os.environ.get(env), f"${env}") if env else None
+    clusters = [address or (from_env if scene.fractal else None) for scene in scenes]
+    for scene, cluster in zip(scenes, clusters):  # every scene's refusals before the first render
+        how = "--scheduler" if address else f"${env}" if cluster else "--tiles" if args.tiles else None
+        api.check_render([scene], args.out, how)
     budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
-    for scene in scenes:
-        # as for `batch`, Dask's own variable names the cluster: for the maps, which alone can be tiled
-        scheduler = address or (os.environ.get("DASK_SCHEDULER_ADDRESS") if scene.fractal else None)
+    for scene, cluster in zip(scenes, clusters):
         result = api.render(scene, args.out, arch=args.arch, progress=progress_wanted(args), threads=args.threads,
-                            scheduler=scheduler, tiles=args.tiles)
+                            scheduler=cluster, tiles=args.tiles)
         print(result.line())
     return 0
 

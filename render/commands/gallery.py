@@ -29,7 +29,7 @@ from ..video import poster
 from ..video.atomic import digest, together, write_atomic
 from ..errors import SceneError
 from ..config.limits import DESCRIPTION_MAX
-from ..config.options import check_replaceable
+from ..config.options import check_replaceable, out_path
 from ..video.version import __version__
 
 CSS = """
@@ -298,7 +298,7 @@ def add_parser(sub):
     g = sub.add_parser("gallery", help="write OUT/index.html: every render in OUT with its video and certificate",
                        description="Write OUT/index.html, a page of every render in OUT/ (posters, videos, "
                                    "certificates, sizes), with links relative to it: open it from disk.")
-    g.add_argument("--out", type=Path, default=Path("out"), help="the output root to show (default: out)")
+    g.add_argument("--out", type=out_path, default=Path("out"), help="the output root to show (default: out)")
     g.set_defaults(func=run)
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import SceneError
 from ..config import budget
 from ..config.options import (add_budget, add_common, budgeted, check_out_folder, output_name, progress_wanted,
-                              thread_count)
+                              out_path, thread_count)
 
 FILES = ("lyapunov.png", "lyapunov.json")  # what it writes into OUT/NAME/
 
@@ -53,7 +53,7 @@ def add_parser(sub):
     add_budget(p)
     p.add_argument("--pendulums", type=indices, metavar="I,J,...",
                    help="which pendulums, by index in the fan (default: the certificate's, at most 8)")
-    p.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    p.add_argument("--out", type=out_path, default=Path("out"), help="output root (default: out)")
     p.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress on stderr")
     p.set_defaults(func=run)

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 from ..video import pipeline
-from ..config.options import add_common, add_quality, check_out_folder, output_name, thread_count
+from ..config.options import add_common, add_quality, check_out_folder, out_path, output_name, thread_count
 from ..config.scene import load
 from .player import KEYS_HELP, FrameSource, Player, png_bytes, say  # noqa: F401 - png_bytes: show's PNG, for tests
 from .window import DISPLAY_TIMEOUT_S, Window, check_display  # noqa: F401 - the display timeout is show's to tell
@@ -81,7 +81,7 @@ def add_parser(sub):
                "  b, BackSpace  close the inset, else back to the axes before the last zoom")
     s.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(s)
-    s.add_argument("--out", type=Path, default=Path("out"), help="where s saves frames (default: out)")
+    s.add_argument("--out", type=out_path, default=Path("out"), help="where s saves frames (default: out)")
     add_quality(s)
     s.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     s.set_defaults(func=run)

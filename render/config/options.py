@@ -40,7 +40,7 @@ def add_render_options(p):
     """What `render` and `compare` share after the preset: --set/--arch, --out, --name, --quality, --budget,
     --threads and --no-progress."""
     add_common(p)
-    p.add_argument("--out", type=Path, default=Path("out"), help="output root (default: out)")
+    p.add_argument("--out", type=out_path, default=Path("out"), help="output root (default: out)")
     add_name(p)
     add_quality(p)
     add_budget(p)
@@ -132,6 +132,22 @@ def positive_int(text: str, most: int | None = None) -> int:
 
 def thread_count(text: str) -> int:
     return positive_int(text, MAX_THREADS)
+
+
+def out_path(text: str) -> Path:
+    """An argparse type for --out: a path, never an empty one, which an unset shell variable gives and which
+    would quietly mean the current folder ('.' says so)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must name a folder or file, got an empty string ('.' is the current "
+                                         "folder)")
+    return Path(text)
+
+
+def check_out(out, what: str = "out") -> Path:
+    """The API's out=: a path (str or os.PathLike), not empty; SceneError otherwise."""
+    if not isinstance(out, (str, os.PathLike)) or not str(os.fspath(out)).strip():
+        raise SceneError(f"{what}={out!r}: must name a folder or file (a str or a path; '.' is the current folder)")
+    return Path(out)
 
 
 def check_arch(arch) -> str:

@@ -26,9 +26,11 @@ RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's
 CONNECT_TIMEOUT = "10s"  # how long Client keeps trying a scheduler (it retries a refused connection till then)
 
 
-def scheduler_address(text: str | None) -> str | None:
-    """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client."""
-    if not text:
+def scheduler_address(text: str | None, what: str = "--scheduler") -> str | None:
+    """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client. None for
+    none given; an empty one is refused from the command line (it would quietly render locally), and taken as
+    unset from the environment (`what` names it: "$DASK_SCHEDULER_ADDRESS"), as an empty variable is."""
+    if text is None or (not text.strip() and what.startswith("$")):
         return None
     address = text if "://" in text else f"tcp://{text}"
     # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
@@ -36,7 +38,7 @@ def scheduler_address(text: str | None) -> str | None:
     m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
     port = m and m.group(3)
     if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
-        raise SceneError(f"--scheduler {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
+        raise SceneError(f"{what} {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
     return address
 
 
