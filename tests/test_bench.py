@@ -258,6 +258,17 @@ def test_repeat_must_be_a_positive_count(capsys, tmp_path):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("name", bench.FILES)
+def test_a_folder_where_a_report_file_goes_is_refused_before_the_bench_runs(capsys, tmp_path, name):
+    """Found only when the report is written, it cost a whole bench (6 minutes or more) and left the files
+    written before it: refused at once now, and the files are written together (atomic.together)."""
+    (tmp_path / "b" / name).mkdir(parents=True)
+    assert cli.main(["bench", "--quick", "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(tmp_path / "b" / name) in err[0] and "is a folder" in err[0]
+    assert [p.name for p in (tmp_path / "b").iterdir()] == [name]
+
+
 def test_effects_table_shows_a_difference_within_the_noise_as_plus_minus():
     def run(effects, sim, draw):
         return {"preset": "rigid_chaos", "effects": effects, "sim": sim, "draw": draw, "fields": 0, "kernels": 2}

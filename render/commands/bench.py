@@ -26,8 +26,8 @@ from . import peers
 from .bench_process import maxrss_mb, run_phase
 from .bench_sim import phase_sim
 from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
-from ..video.atomic import write_atomic
-from ..config.options import check_writable, out_path, positive_int
+from ..video.atomic import together, write_atomic
+from ..config.options import check_replaceable, check_writable, out_path, positive_int
 from ..physics import vector_width
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
@@ -46,6 +46,7 @@ SIZE = ["video.width=1280", "video.height=720"]
 FULL = {"ladder": [100, 1000, 10**4, 10**5, 10**6], "chaos_s": 20.0, "min_s": 0.3, "rainbow_s": None, "peer_s": 10.0,
         "fractal_s": {"angles": 2.0, "flip_time": None, "divergence": None, "lyapunov": 1.0}, "rounds": 3,
         "warm_maps": True}
+FILES = ("report.json", "report.md", "rates.json", "targets.md")  # what a run writes into --out
 QUICK = {"ladder": [100, 10**5], "chaos_s": 2.0, "min_s": 0.1, "rainbow_s": 3.0, "peer_s": 1.0,
          "fractal_s": {"angles": 0.1, "flip_time": 0.1, "divergence": 0.1, "lyapunov": 0.1},  # smoke: a few frames
          "rounds": 2, "warm_maps": False}
@@ -81,6 +82,8 @@ def run(args) -> int:
         args.result.write_text(json.dumps({**result, "maxrss_mb": maxrss_mb()}))
         return 0
     check_writable(args.out)
+    for name in FILES:  # a folder or an immutable file where one goes: refused now, not after minutes of bench
+        check_replaceable(args.out / name)
     width = vector_width.planned()  # a bad $PENDULUM_VECTOR_WIDTH stops the bench here, not in its first phase
     load = os.getloadavg()  # other work on the machine skews every figure: the report says how much
     print(f"bench: load average {load_text(load)} at the start, {cpu_kind()} CPU, "
@@ -93,19 +96,20 @@ def run(args) -> int:
     report = summarise(res, args.quick, time.perf_counter() - t0, cfg["chaos_s"], load)
     print(f"bench: load average {load_text(report['machine']['load_avg_end'])} at the end", file=sys.stderr)
     args.out.mkdir(parents=True, exist_ok=True)
-    write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
-    write_atomic(args.out / "report.md", markdown(report).encode())
-    # This machine's rates for the run-time budget of renders into the OUT above (render/config/estimate.py)
-    rates = {**estimate.measured(res, chaos_scene(cfg)), "created": report["created"], "quick": report["quick"]}
-    write_atomic(args.out / "rates.json", (json.dumps(rates, indent=2) + "\n").encode())
-    m = report["machine"]
-    write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
-        targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
-                                 f"{m['cpus']} CPUs ({m['cpu']}, {m['cpu_kind']} targets, {width_text(m)}), "
-                                 "load average "
-                                 f"{m['load_avg'][0]:.2f} at the start and {m['load_avg_end'][0]:.2f} at the end, "
-                                 f"{report['rounds']} interleaved rounds, numba {report['peers']['numba']}."]).encode()
-        + b"\n")
+    with together():  # the report, the rates and the table appear together, or none of them
+        write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
+        write_atomic(args.out / "report.md", markdown(report).encode())
+        # This machine's rates for the run-time budget of renders into the OUT above (render/config/estimate.py)
+        rates = {**estimate.measured(res, chaos_scene(cfg)), "created": report["created"], "quick": report["quick"]}
+        write_atomic(args.out / "rates.json", (json.dumps(rates, indent=2) + "\n").encode())
+        m = report["machine"]
+        write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
+            targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
+                                     f"{m['cpus']} CPUs ({m['cpu']}, {m['cpu_kind']} targets, {width_text(m)}), "
+                                     "load average "
+                                     f"{m['load_avg'][0]:.2f} at the start and {m['load_avg_end'][0]:.2f} at the end, "
+                                     f"{report['rounds']} interleaved rounds, numba {report['peers']['numba']}."]).encode()
+            + b"\n")
     for key, t in report["targets"].items():
         print(f"{key} = {fmt(t['value'])} (target {t['goal']}): "
               f"{'met' if t['met'] else 'not measured' if t['met'] is None else 'MISSED'}")
