@@ -238,6 +238,7 @@ BAD = [
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3"], ["--vary integrator.dt", "1 value"]),
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3,2e-3,3e-3"], ["paired"]),
     (["--vary", "integrator.dt=1e-3,1e-3"], ["compare.vary", "the same variant"]),
+    (["--quality", "draft", "--vary", "integrator.dt=1e-3,5e-4"], ["compare.vary.integrator.dt", "every panel's integrator"]),
     (["--vary", "integrator.method=rk2,rk4,rk2", "--vary", "integrator.dt=1e-3,1e-3,1e-3"], ["the same variant"]),
     ([], ["rigid_chaos.toml", "compare", "no [compare] table", "--vary"]),
 ]

@@ -286,6 +286,9 @@ class Validator(Checker):
             why = vary_refusal(key)
             if why:
                 self.fail(name, f"cannot vary: {why}; {VARYING}")
+            if d.get("quality") is not None and key.startswith("integrator."):  # every panel's would be replaced
+                self.fail(name, f"quality {d['quality']!r} (--quality) chooses every panel's integrator, so the "
+                          f"panels would not differ by it; vary quality itself, or leave --quality out")
             lo, hi = VARIANTS
             if not isinstance(values, list) or not lo <= len(values) <= hi:
                 self.fail(name, f"must list {lo} to {hi} values (one per panel), got {clip(repr(values))}")
