@@ -137,6 +137,12 @@ def test_simulate_returns_the_arrays_the_npz_holds(tmp_path, monkeypatch):
     page = traj._repr_html_()
     assert "<table>" in page and "theta 20x1x2" in page and "not written" in page
     assert traj.energy_drift() < 1e-6 and traj.certificate["fraction_faithful"] == 1.0
+    (tmp_path / "d.npz").mkdir()
+    (tmp_path / "file").write_text("a file")
+    for bad, says in (("d.npz", "is a directory"), ("file/x.npz", "not a writable directory"), ("x.txt", ".npz")):
+        with pytest.raises(SceneError, match=says):  # as simulate(out=) refuses it, before compressing anything
+            traj.save(bad)
+    assert traj.save("new/t.npz") == Path("new/t.npz") and (tmp_path / "new" / "t.npz").is_file()
 
 
 def test_simulate_errors_are_the_clis_typed_exceptions(tmp_path):
@@ -210,6 +216,15 @@ def test_the_api_refuses_what_the_cli_refuses_before_any_work(tmp_path, no_pipel
     with pytest.raises(SceneError) as e:
         getattr(render, call)(scene, out=tmp_path / ("o.npz" if call == "simulate" else "o"), **kwargs)
     assert all(n in str(e.value) for n in needles) and "\n" not in str(e.value), str(e.value)
+    assert no_pipeline == [] and not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("call", ["render", "simulate", "compare"])
+def test_an_empty_out_is_refused_not_taken_as_the_current_folder(tmp_path, monkeypatch, no_pipeline, call):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError, match="out='': must name a folder or file"):
+        extra = {"vary": VARY} if call == "compare" else {}
+        getattr(render, call)(render.load("rigid_chaos", **SMALL), out="", **extra)
     assert no_pipeline == [] and not any(tmp_path.iterdir())
 
 

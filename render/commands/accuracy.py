@@ -250,7 +250,8 @@ def add_parser(sub):
                                    "and accuracy.csv/.md, measured against a scipy DOP853 reference.")
     p.add_argument("--system", choices=(*registry.names(), "all"), default="all",
                    help=f"which system to measure (default: all); the system of {CHAOS} also draws divergence.png")
-    p.add_argument("--out", type=out_path, default=Path("out/accuracy"), help="output directory (default: out/accuracy)")
+    p.add_argument("--out", type=out_path, default=Path("out/accuracy"),
+                   help="output directory (default: out/accuracy)")
     p.add_argument("--quick", action="store_true", help="two dt rungs, small N, short runs: a smoke test")
     p.add_argument("--arch", choices=("cpu", "cuda"), default="cpu", help="Taichi backend for the kernels")
     p.add_argument("--no-progress", action="store_true", help="no progress on stderr")

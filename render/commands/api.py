@@ -22,8 +22,8 @@ from . import batch_plan
 from ..video import pipeline
 from ..physics import registry
 from ..errors import SceneError
-from ..config.options import (check_arch, check_out, check_out_folder, check_replaceable, check_threads,
-                              check_tiles, check_writable, usable_cores)
+from ..config.options import (check_arch, check_npz, check_out, check_out_folder, check_threads, check_tiles,
+                              usable_cores)
 from ..config.vary import VARIANTS, VARYING, vary_refusal
 from .results import RenderResult, Trajectory
 
@@ -106,16 +106,6 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
             meta = pipeline.render(scene, out, arch=arch, progress=progress, threads=threads, cluster=client,
                                    bands=tiles)
     return RenderResult(scene, scene.out_dir(out), meta)
-
-
-def check_npz(out: Path, name: str) -> None:
-    """Refuse (SceneError) a trajectory file that cannot be written, before any work."""
-    if out.suffix != ".npz":
-        raise SceneError(f"--out {out}: must end in .npz")
-    if out.is_dir():
-        raise SceneError(f"--out {out}: is a directory; give the file to write, e.g. {out / name}.npz")
-    check_writable(out.parent, f"--out {out}: its folder")
-    check_replaceable(out)
 
 
 def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",

@@ -103,13 +103,12 @@ def run(args) -> int:
         rates = {**estimate.measured(res, chaos_scene(cfg)), "created": report["created"], "quick": report["quick"]}
         write_atomic(args.out / "rates.json", (json.dumps(rates, indent=2) + "\n").encode())
         m = report["machine"]
-        write_atomic(args.out / "targets.md", "\n".join(  # for docs/performance.md (benchmarks/readme_figures.py)
-            targets_table(report) + ["", f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, "
-                                     f"{m['cpus']} CPUs ({m['cpu']}, {m['cpu_kind']} targets, {width_text(m)}), "
-                                     "load average "
-                                     f"{m['load_avg'][0]:.2f} at the start and {m['load_avg_end'][0]:.2f} at the end, "
-                                     f"{report['rounds']} interleaved rounds, numba {report['peers']['numba']}."]).encode()
-            + b"\n")
+        line = (f"`pendulum bench{' --quick' if report['quick'] else ''}`, {report['created']}, {m['cpus']} CPUs "
+                f"({m['cpu']}, {m['cpu_kind']} targets, {width_text(m)}), load average {m['load_avg'][0]:.2f} at the "
+                f"start and {m['load_avg_end'][0]:.2f} at the end, {report['rounds']} interleaved rounds, numba "
+                f"{report['peers']['numba']}.")
+        # for docs/performance.md (benchmarks/readme_figures.py)
+        write_atomic(args.out / "targets.md", "\n".join(targets_table(report) + ["", line]).encode() + b"\n")
     for key, t in report["targets"].items():
         print(f"{key} = {fmt(t['value'])} (target {t['goal']}): "
               f"{'met' if t['met'] else 'not measured' if t['met'] is None else 'MISSED'}")

@@ -15,8 +15,8 @@ import traceback
 from pathlib import Path
 
 from ..errors import BatchError, EncodeError, SceneError, SimulationError
-from ..config.options import (add_budget, add_common, add_quality, add_render_options, add_tiles, budgeted, output_name,
-                              out_path, progress_wanted)
+from ..config.options import (add_budget, add_common, add_quality, add_render_options, add_tiles, budgeted, check_npz,
+                              out_path, output_name, progress_wanted)
 
 # Subcommands living in their own modules: command -> (module, the line `pendulum --help` lists it with). Each
 # module has add_parser(subparsers) and run(args) -> exit code. Only the module of the command given is imported:
@@ -149,7 +149,7 @@ def cmd_simulate(args) -> int:
     from . import api
     from ..config import budget
 
-    api.check_npz(args.out, scene.name)
+    check_npz(args.out, scene.name)
     budget.check_run([scene], args.out.parent, simulate=True)  # the estimate, when over a minute
     traj = api.simulate(scene, args.out, arch=args.arch, progress=progress_wanted(args))
     print(f"{scene.name}: {traj.info['frames']} frames, {traj.info['line']} -> {args.out}")

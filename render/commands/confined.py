@@ -8,8 +8,9 @@ symlink out of OUT. So nothing here follows a symlink: a folder is taken only wh
 at every step below the root, a file only when it is a regular one, opened with O_NOFOLLOW | O_NONBLOCK and
 checked with fstat before a byte is read, and a file name from metadata only when it is one plain name in its
 own folder. Whatever is refused raises Refused, whose message says why in a few words, for the card that
-shows it (render/commands/gallery.py). A preset is read the same way (render/video/files.py), symlinks followed: a user's
-preset may be a link, but a FIFO or /dev/zero given as one must not hang the command or fill memory.
+shows it (render/commands/gallery.py). A preset is read the same way (render/video/files.py), symlinks
+followed: a user's preset may be a link, but a FIFO or /dev/zero given as one must not hang the command or fill
+memory.
 """
 from __future__ import annotations
 

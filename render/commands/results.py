@@ -128,12 +128,11 @@ class Trajectory(Mapping):
 
     def save(self, path: str | os.PathLike) -> Path:
         """Write the arrays to a .npz as `pendulum simulate` does (atomically)."""
+        from ..config.options import check_npz
         from ..video.atomic import replacing
 
         path = Path(path)
-        if path.suffix != ".npz":
-            from ..errors import SceneError
-            raise SceneError(f"{path}: a trajectory file must end in .npz")
+        check_npz(path, self.scene.name)  # as simulate(out=) checks it: before the file is compressed
         path.parent.mkdir(parents=True, exist_ok=True)
         with replacing(path, suffix=".npz") as tmp:
             np.savez_compressed(tmp, **self.arrays)

@@ -231,6 +231,15 @@ def check_out_folder(scene, out: Path, files: tuple[str, ...] | None = None):
         check_replaceable(folder / name)
 
 
+def check_npz(out: Path, name: str) -> None:
+    """Refuse (SceneError) a trajectory file that cannot be written, before any work."""
+    if out.suffix != ".npz":
+        raise SceneError(f"--out {out}: must end in .npz")
+    if out.is_dir():
+        raise SceneError(f"--out {out}: is a directory; give the file to write, e.g. {out / name}.npz")
+    check_writable(out.parent, f"--out {out}: its folder")
+    check_replaceable(out)
+
 def check_replaceable(path: Path, what: str = "--out"):
     """Bad input if `path` is a folder, or a file that is there and cannot be replaced by renaming a finished
     file onto it (render/video/atomic.py), which would fail only after the work. Even root cannot replace an
