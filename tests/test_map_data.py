@@ -126,6 +126,25 @@ def test_load_map_refuses_what_is_not_a_map(tmp_path):
     (tmp_path / "y.npz").write_text("hello")
     with pytest.raises(ValueError, match="y.npz: not a map's data"):
         render.load_map(tmp_path / "y.npz")
+    h, w = 2, 3  # a map's fields, the shapes render/maps/data.py gives; then each one damaged
+    good = {"colouring": "flip_time", "unit": "s", "x_quantity": "theta1", "y_quantity": "theta2", "x_unit": "rad",
+            "y_unit": "rad", "x": np.zeros(w), "y": np.zeros(h), "starts": np.zeros((h, w, 1, 2)),
+            "value": np.zeros((h, w, 1), np.float32), "t": 1.0, "cannot_flip": np.zeros((h, w, 1), bool),
+            "trusted_until": np.zeros((h, w), np.float32), "trusted": np.ones((h, w, 1), bool), "pending": -1.0,
+            "never": -2.0}
+    np.savez(tmp_path / "good.npz", **good)
+    assert render.load_map(tmp_path / "good.npz").value.shape == (h, w, 1)
+    for name, bad, says in (("t", np.arange(3.0), "t is"), ("x", np.zeros(4), "plot's 2 x 4 pixels"),
+                            ("unit", np.zeros(2), "unit is"), ("trusted", np.ones((w, h)), "trusted is")):
+        np.savez(tmp_path / "bad.npz", **{**good, name: bad})
+        with pytest.raises(ValueError, match=f"bad.npz: not a map's data \\(.*{says}"):
+            render.load_map(tmp_path / "bad.npz")
+    raw = bytearray((tmp_path / "good.npz").read_bytes())
+    at = raw.index(b"starts.npy") + 200  # inside that member's bytes: its CRC no longer matches
+    raw[at] ^= 0xFF
+    (tmp_path / "crc.npz").write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match="crc.npz: not a map's data"):
+        render.load_map(tmp_path / "crc.npz")
 
 
 def test_a_render_that_fails_as_it_finishes_leaves_no_npz(tmp_path, monkeypatch):

@@ -35,6 +35,8 @@ from ..physics import grid
 PENDING = -1.0  # not happened (yet)
 NEVER = -2.0  # cannot happen: below the energy barrier
 UNITS = {"flip_time": "s", "divergence": "s", "lyapunov": "1/s", "angles": "rad"}
+TEXT = ("colouring", "unit", "x_quantity", "y_quantity", "x_unit", "y_unit")  # the fields that are one text each
+NUMBERS = ("t", "pending", "never")  # one number each
 
 
 @dataclasses.dataclass(frozen=True)
@@ -101,9 +103,32 @@ def load(path) -> MapData:
         missing = sorted(fields - set(z.files))
         if missing:
             raise ValueError(f"{path}: not a map's data (no {', '.join(missing)})")
-        got = {k: z[k] for k in fields}
-    for k in ("colouring", "unit", "x_quantity", "y_quantity", "x_unit", "y_unit"):
+        try:  # a member damaged in the file (a bad CRC, bytes that are no array) shows only as it is read
+            got = {k: z[k] for k in fields}
+        except (ValueError, OSError, EOFError, zipfile.BadZipFile) as e:
+            raise ValueError(f"{path}: not a map's data ({e})") from None
+    why = _misshapen(got)
+    if why:
+        raise ValueError(f"{path}: not a map's data ({why})")
+    for k in TEXT:
         got[k] = str(got[k])
-    for k in ("t", "pending", "never"):
+    for k in NUMBERS:
         got[k] = float(got[k])
     return MapData(**got)
+
+
+
+def _misshapen(got: dict) -> str | None:
+    """What in the fields does not have the shape the module's docstring gives (H, W from y and x), or None."""
+    for k in (*TEXT, *NUMBERS):
+        if got[k].ndim != 0 or (got[k].dtype.kind not in "USO" if k in TEXT else got[k].dtype.kind not in "fiu"):
+            return f"{k} is {got[k].dtype} of shape {got[k].shape}, not one {'text' if k in TEXT else 'number'}"
+    x, y = got["x"], got["y"]
+    if x.ndim != 1 or y.ndim != 1 or x.dtype.kind != "f" or y.dtype.kind != "f":
+        return f"x {x.shape} and y {y.shape} are not rows of numbers"
+    plot = (len(y), len(x))
+    for k, ndim in (("starts", 4), ("value", 3), ("cannot_flip", 3), ("trusted_until", 2), ("trusted", 3)):
+        a = got[k]
+        if a.ndim < ndim or a.shape[:2] != plot or a.dtype.kind not in "fbiu":
+            return f"{k} is {a.dtype} of shape {a.shape}, not of the plot's {plot[0]} x {plot[1]} pixels"
+    return None
