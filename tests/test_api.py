@@ -59,6 +59,8 @@ def test_load_takes_dotted_keys_nested_dicts_and_set_strings():
     ({"video": {"duration": -1}}, ["classic.toml", "video.duration"]),
     ({"name": {"x": 1}}, ["classic.toml", "name: not a section"]),
     ({"quality": "superb"}, ["classic.toml", "unknown level 'superb'"]),
+    ({"pendulums": {"gravity": 1j}}, ["pendulums.gravity=1j", "a number, a string"]),
+    ({"video": {"fps": object()}}, ["video.fps=", "a number, a string"]),
 ])
 def test_load_refuses_bad_overrides_naming_file_and_key(kwargs, needles):
     quality = kwargs.pop("quality", None)
@@ -66,6 +68,11 @@ def test_load_refuses_bad_overrides_naming_file_and_key(kwargs, needles):
         render.load("classic", quality=quality, **kwargs)
     assert all(n in str(e.value) for n in needles), str(e.value)
     assert "\n" not in str(e.value)
+
+
+def test_load_takes_only_strings_as_set_settings():
+    with pytest.raises(SceneError, match="settings are strings as --set takes them"):
+        render.load("classic", 5)
 
 
 def test_an_unknown_preset_is_a_scene_error():
@@ -206,6 +213,11 @@ VARY = {"integrator.precision": ["f32", "f64"]}
     ("render", {"threads": 2.0}, ["threads=2.0", "an integer"]),
     ("render", {"threads": True}, ["threads=True", "an integer"]),
     ("compare", {"vary": 42}, ["vary=int", "a dict", "--vary"]),
+    ("compare", {"vary": {}}, ["vary={}", "each key to vary"]),
+    ("compare", {"vary": {5: [1, 2]}}, ["5: not a key name"]),
+    ("render", {"scheduler": 5}, ["scheduler=5", "an address string"]),
+    ("render", {"progress": "yes"}, ["progress='yes'", "True or False"]),
+    ("simulate", {"progress": 1}, ["progress=1", "True or False"]),
     ("compare", {"vary": "integrator.dt=1e-3"}, ["--vary integrator.dt", "1 value(s)", "2 to 4"]),
     ("compare", {"vary": ["integrator.tolerance=1e-3,1e-2"]}, ["--vary integrator.tolerance", "cannot vary"]),
     ("compare", {"vary": {"integrator.dt": [1e-3, 5e-4], "integrator": {"dt": [2e-3, 5e-4]}}},

@@ -24,6 +24,7 @@ from ..physics import registry
 from ..errors import SceneError
 from ..config.options import (check_arch, check_npz, check_out, check_out_folder, check_threads, check_tiles,
                               usable_cores)
+from ..config.checks import clip
 from ..config.vary import VARIANTS, VARYING, vary_refusal
 from .results import RenderResult, Trajectory
 
@@ -35,6 +36,10 @@ def load(preset: str | os.PathLike, /, *settings: str, quality: str | None = Non
     `load("classic", video={"duration": 2})`; `settings` are strings as `--set` takes them
     ("video.duration=2", the value in TOML). `quality` is a --quality level (draft, standard, high, reference).
     """
+    for setting in settings:
+        if not isinstance(setting, str):
+            raise SceneError(f"load({preset!r}, {clip(repr(setting))}): settings are strings as --set takes them, "
+                             f"'KEY=VALUE'; give other values as keywords, load(..., video={{'fps': 30}})")
     values = {}
     for key, value in overrides.items():
         _flatten(key, value, values)
@@ -44,20 +49,31 @@ def load(preset: str | os.PathLike, /, *settings: str, quality: str | None = Non
 def _flatten(key: str, value, out: dict) -> None:
     """video={"duration": 2} -> out["video.duration"] = 2; numpy scalars and arrays, tuples as plain TOML
     values (the validator checks types as TOML gives them)."""
+    if not isinstance(key, str):
+        raise SceneError(f"{clip(repr(key))}: not a key name (a key is a string, 'integrator.dt')")
     if isinstance(value, dict):
         for k, v in value.items():
             _flatten(f"{key}.{k}", v, out)
         return
     if key in out:  # {"video.fps": 30, "video": {"fps": 60}}: neither may silently win
         raise SceneError(f"{key}: given twice (once dotted, once in a nested dict); give it once")
-    out[key] = _plain(value)
+    out[key] = _plain(value, key)
 
 
-def _plain(value):
+def _plain(value, key: str):
     if hasattr(value, "tolist") and callable(value.tolist):  # numpy scalar or array
         value = value.tolist()
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [_plain(v, key) for v in value]
+    if not isinstance(value, (bool, int, float, str)):  # what TOML holds; the validator judges the rest
+        raise SceneError(f"{key}={clip(repr(value))}: must be a number, a string, a boolean or a list of them")
+    return value
+
+
+def check_flag(value, name: str) -> bool:
+    """The API's progress=: a bool, as the CLI's --no-progress is one (a string "no" would be true)."""
+    if not isinstance(value, bool):
+        raise SceneError(f"{name}={clip(repr(value))}: must be True or False")
     return value
 
 
@@ -92,6 +108,9 @@ def render(scene, out: str | os.PathLike = "out", *, arch: str = "cpu", threads:
 
     scene = _scene(scene)
     arch, threads, out = check_arch(arch), check_threads(threads), check_out(out)
+    progress = check_flag(progress, "progress")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise SceneError(f"scheduler={clip(repr(scheduler))}: must be an address string, as --scheduler takes it")
     address, tiles = tiled.scheduler_address(scheduler), check_tiles(tiles)
     how = "--scheduler" if address else "--tiles" if tiles else None
     check_render([scene], out, how)
@@ -112,7 +131,7 @@ def simulate(scene, out: str | os.PathLike | None = None, *, arch: str = "cpu",
              progress: bool = False) -> Trajectory:
     """Simulate a Scene (or a preset name) without drawing: the state at every frame time, as the .npz of
     `pendulum simulate` holds it. Nothing is written unless `out` names a .npz file."""
-    scene, arch = _scene(scene), check_arch(arch)
+    scene, arch, progress = _scene(scene), check_arch(arch), check_flag(progress, "progress")
     out = check_out(out) if out is not None else None
     if out is not None:
         check_npz(out, scene.name)
@@ -137,6 +156,9 @@ def compare(scene, vary: dict | str | list[str] | None = None, out: str | os.Pat
     check_threads(threads)
     if isinstance(vary, str):
         vary = [vary]
+    if isinstance(vary, dict) and not vary:
+        raise SceneError("vary={}: give each key to vary with its values, {KEY: [V1, V2]}, or leave vary out for the "
+                         "preset's own [compare] table")
     if isinstance(vary, dict):
         values = {}
         for key, val in vary.items():

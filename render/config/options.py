@@ -147,6 +147,8 @@ def check_out(out, what: str = "out") -> Path:
     """The API's out=: a path (str or os.PathLike), not empty; SceneError otherwise."""
     if not isinstance(out, (str, os.PathLike)) or not str(os.fspath(out)).strip():
         raise SceneError(f"{what}={out!r}: must name a folder or file (a str or a path; '.' is the current folder)")
+    if "\0" in str(os.fspath(out)):
+        raise SceneError(f"{what}={str(os.fspath(out))!r}: a path cannot contain a NUL character")
     return Path(out)
 
 
