@@ -114,6 +114,9 @@ def test_a_gif_only_render_embeds_the_gif_when_small(tmp_path, monkeypatch):
     [(tag, src)] = media_of(result._repr_html_())
     assert tag == "img" and src.startswith("data:image/gif;base64,")
     assert base64.b64decode(src.split(",", 1)[1]) == result.paths["gif"].read_bytes()
+    still = render.render(render.load("classic", **SMALL, video={**FRAME, "formats": ["png"]}), out="p")
+    [(tag, png)] = media_of(still._repr_html_())  # a still only: it shows, not "(no video file)"
+    assert tag == "img" and base64.b64decode(png.split(",", 1)[1]) == still.paths["png"].read_bytes()
     monkeypatch.setattr("render.commands.results.EMBED_BYTES", 10)  # a large GIF is linked, not embedded
     [(tag, src)] = media_of(result._repr_html_())
     assert tag == "img" and src == "o/classic/classic.gif" and Path(src).is_file()

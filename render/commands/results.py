@@ -78,16 +78,18 @@ class RenderResult:
         return f"<div>{self.media_html()}{_table(rows)}</div>"
 
     def media_html(self) -> str:
-        """The <video> (or the GIF) that shows this render."""
-        mp4, gif = self.paths.get("mp4"), self.paths.get("gif")
+        """The <video> (or the GIF, or the last frame's still) that shows this render."""
+        mp4 = self.paths.get("mp4")
         if mp4 is not None and mp4.is_file():
             return (f'<video src="{_src(mp4)}" controls loop muted autoplay playsinline '
                     f'style="max-width:100%;display:block"></video>')
-        if gif is not None and gif.is_file():
-            if gif.stat().st_size <= EMBED_BYTES:
-                data = base64.b64encode(gif.read_bytes()).decode()
-                return f'<img src="data:image/gif;base64,{data}" alt="{_e(gif.name)}" style="max-width:100%">'
-            return f'<img src="{_src(gif)}" alt="{_e(gif.name)}" style="max-width:100%">'
+        for kind in ("gif", "png"):  # a png-only render (formats = ["png"]) shows its still
+            image = self.paths.get(kind)
+            if image is not None and image.is_file():
+                if image.stat().st_size <= EMBED_BYTES:
+                    data = base64.b64encode(image.read_bytes()).decode()
+                    return f'<img src="data:image/{kind};base64,{data}" alt="{_e(image.name)}" style="max-width:100%">'
+                return f'<img src="{_src(image)}" alt="{_e(image.name)}" style="max-width:100%">'
         return "<p>(no video file)</p>"
 
 
