@@ -238,7 +238,10 @@ BAD = [
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3"], ["--vary integrator.dt", "1 value"]),
     (["--vary", "integrator.method=rk4,rk2", "--vary", "integrator.dt=1e-3,2e-3,3e-3"], ["paired"]),
     (["--vary", "integrator.dt=1e-3,1e-3"], ["compare.vary", "the same variant"]),
-    (["--quality", "draft", "--vary", "integrator.dt=1e-3,5e-4"], ["compare.vary.integrator.dt", "every panel's integrator"]),
+    (["--quality", "draft", "--vary", "integrator.dt=1e-3,5e-4"],
+     ["compare.vary.integrator.dt", "every panel's integrator"]),
+    (["--set", "video.width=64", "--set", "video.height=36", "--vary", "integrator.dt=1e-3,5e-4,2.5e-4"],
+     ["video.height: 36 px leaves panels 6 px high"]),
     (["--vary", "integrator.method=rk2,rk4,rk2", "--vary", "integrator.dt=1e-3,1e-3,1e-3"], ["the same variant"]),
     ([], ["rigid_chaos.toml", "compare", "no [compare] table", "--vary"]),
 ]
@@ -269,7 +272,8 @@ def test_a_grid_of_two_keys_repeats_each_value_and_is_four_distinct_panels():
     ('vary = { "integrator.precision" = ["f32"] }', ["compare.vary.integrator.precision", "2 to 4"]),
     ('vary = { integrator.dt = [1e-3, 0.5] }', ["variant 2", "integrator.dt", "stability limit"]),
     ('varry = { "integrator.dt" = [1e-3, 2e-3] }', ["compare.varry", "did you mean 'compare.vary'"]),
-    ('vary = { "pendulums.stiffness" = [1.0, 2.0] }', ["compare.vary.pendulums.stiffness", "unknown key"]),
+    ('vary = { "pendulums.stiffness" = [1.0, 2.0] }',
+     ["compare.vary.pendulums.stiffness", "belongs to system elastic"]),
     ('vary = { "integrator.dt" = [1e-3, 2e-3], "integrator.method" = ["rk4", "rk2", "rk4"] }', ["paired"]),
     ('vary = { "integrator.dt" = [1979-05-27, 1e-3] }', ["compare.vary.integrator.dt", "numbers, strings"]),
 ])

@@ -81,11 +81,27 @@ def _scene(scene) -> scenes.Scene:
     return scene if isinstance(scene, scenes.Scene) else load(scene)
 
 
+def check_panels(scene) -> None:
+    """Refuse a comparison whose panels, under the shared clock's band (render/draw/split.py's layout), would
+    be smaller than a video may be: found only once every variant had been simulated, before."""
+    from ..draw.split import layout
+    from ..config.vary import PANEL_MIN
+    v = scene.video
+    rects = layout(v.width, v.height, len(scene.compare[0][1]))
+    w, h = min(r[2] for r in rects), min(r[3] for r in rects)
+    for key, size, side, way in (("width", v.width, w, "wide"), ("height", v.height, h, "high")):
+        if side < PANEL_MIN:
+            raise SceneError(f"{scene.source}: video.{key}: {size} px leaves panels {side} px {way} beside the "
+                             f"shared clock; each needs at least {PANEL_MIN}: use a larger video")
+
+
 def check_render(scene_list, out: Path, tiled: str | None = None) -> None:
     """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder), a
     scene over the budget, or with `tiled` (the option asking for it) one that cannot be rendered in tiles."""
     out = Path(out)
     for scene in scene_list:
+        if scene.compare:
+            check_panels(scene)
         if tiled:
             from ..video import tiled as tiling
             tiling.check(scene, tiled)

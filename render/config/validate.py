@@ -282,6 +282,10 @@ class Validator(Checker):
         for key, values in flat.items():
             name = f"compare.vary.{show_key(key)}"
             if key not in known:  # hinted among the keys a comparison may vary
+                section, _, leaf = key.rpartition(".")
+                owners = [n for n in SYSTEMS if section == "pendulums" and leaf in registry.get(n).preset_keys()]
+                if owners:
+                    self.fail(name, f"is not a key of this system (it belongs to system {' and '.join(owners)})")
                 self.fail(name, "unknown key" + hint(key, [k for k in known if not vary_refusal(k)]))
             why = vary_refusal(key)
             if why:
