@@ -335,3 +335,27 @@ def test_show_refuses_the_thread_counts_render_refuses(tmp_path):
     for bad in ("0", "1025", "-2"):
         r = cli(tmp_path, "show", "classic", "--threads", bad, env={"DISPLAY": ":4216"})
         refused(r, tmp_path, "--threads", bad)
+
+
+def test_a_sigterm_that_lands_in_a_finalizer_still_terminates_and_prints_nothing(tmp_path):
+    """Python only prints an exception raised in a __del__ (llvmlite's, during a bench) and goes on: the SIGTERM
+    was lost and a traceback printed. cli.on_signals sends it again, outside the finalizer."""
+    code = """if True:
+        import os, signal, time
+        from render.commands import cli
+        cli.on_signals()
+        class Finalized:
+            def __del__(self):
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.01)  # the handler raises here, inside the finalizer
+        try:
+            x = Finalized()
+            del x
+            time.sleep(2)
+            print("not terminated")
+        except cli.Terminated:
+            print("terminated")
+    """
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.stdout.strip() == "terminated" and r.stderr == "", (r.stdout, r.stderr)
+

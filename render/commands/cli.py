@@ -6,11 +6,13 @@ PENDULUM_DEBUG=1 prints the traceback as well.
 """
 from __future__ import annotations
 
+import _thread
 import argparse
 import importlib
 import os
 import signal
 import sys
+import time
 import traceback
 from pathlib import Path
 
@@ -168,15 +170,37 @@ def cmd_presets(args) -> int:
     return 0
 
 
-def main(argv=None) -> int:
+RESEND_S = 0.005  # a signal lost in a finalizer comes again this much later: the finalizer has returned by then
+
+
+def on_signals():
+    """SIGTERM raises Terminated and SIGINT KeyboardInterrupt, so that every cleanup runs (main() says one line).
+    A process started in the background by a non-interactive shell inherits SIGINT ignored, and Python then
+    installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. A signal that lands in
+    a finalizer (a __del__ of llvmlite's, say) raises there, where Python only prints the exception and goes on
+    (a SIGTERM was lost so): the signal is sent again from a thread, so its handler runs once the finalizer has
+    returned, and nothing is printed."""
     def on_term(signum, frame):
         raise Terminated()
 
+    def resend(signum):
+        time.sleep(RESEND_S)
+        os.kill(os.getpid(), signum)
+
+    def unraisable(info, passed_on=sys.unraisablehook):
+        for kind, signum in ((Terminated, signal.SIGTERM), (KeyboardInterrupt, signal.SIGINT)):
+            if isinstance(info.exc_value, kind):  # raised here, the handler would run inside this hook; and
+                _thread.start_new_thread(resend, (signum,))  # Thread.start() waits for its thread, so it would too
+                return
+        passed_on(info)
+
     signal.signal(signal.SIGTERM, on_term)
-    # A process started in the background by a non-interactive shell inherits SIGINT ignored, and Python then
-    # installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. Ctrl-C or
-    # `kill -INT` always interrupts a render here (and cleans up, below).
     signal.signal(signal.SIGINT, signal.default_int_handler)
+    sys.unraisablehook = unraisable
+
+
+def main(argv=None) -> int:
+    on_signals()
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     # read before parsing, so that even an error while parsing can show its traceback
     debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")
