@@ -169,12 +169,17 @@ def test_rigid_step_symplecticity(method, symplectic):
 
 def test_every_quality_level_is_stable_on_every_preset():
     """The --quality table (chosen from the accuracy figures) must never trip the stability check."""
+    from render.errors import SceneError
     from render.trust.quality import LEVELS
     from render.config.scene import list_presets, load
 
     for path in list_presets():
         for level in LEVELS:
-            sc = load(str(path), quality=level)
+            try:
+                sc = load(str(path), quality=level)
+            except SceneError as e:  # a comparison of integrators (compare_methods): the level would choose
+                assert "chooses every panel's integrator" in str(e), e  # each panel's, so it is refused
+                continue
             small = {"video": {"width": 16, "height": 16}} if sc.pendulums.layout == "grid" else {}
             sc = sc.replace(**small) if small else sc.replace(pendulums={"count": 1})  # a grid counts its pixels
             sim = registry.get(sc.system)(sc)  # raises SceneError beyond the method's stability limit

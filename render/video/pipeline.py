@@ -18,9 +18,9 @@ from .atomic import digest, naming, publish, replacing, temp_beside
 from .files import read_regular
 from .metadata import integrator_meta, metadata, run_meta
 
-
 OUTPUTS = ("mp4", "gif", "png", "npz")  # the kinds of file a render writes beside metadata.json (superseded())
 META_MAX_BYTES = 1 << 20  # an earlier render's metadata.json is a few kB
+
 
 def prepare(scene, arch: str, threads: int | None):
     """Before the first frame: the integrator a --quality level calls for, and its faithfulness certificate,
