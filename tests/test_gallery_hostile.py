@@ -283,8 +283,9 @@ def test_the_sweeper_takes_only_what_temp_beside_makes(tmp_path):
     """A user's files that look like a dead writer's temporaries, but for mkstemp's 8 characters or a suffix
     this package never uses, stay; a real one of a dead writer goes."""
     pid = dead_pid()
-    mine = [tmp_path / f".db.{atomic.HOST}-{pid}.snap.gz", tmp_path / f".backup.{atomic.HOST}-{pid}.v1.tar",
-            tmp_path / f".x.mp4.{atomic.HOST}-{pid}.abcdefgh.tar", tmp_path / f".x.mp4.{atomic.HOST}-{pid}.abcdefghi.part"]
+    mine = [tmp_path / f".{name}.{atomic.HOST}-{pid}.{tail}"
+            for name, tail in (("db", "snap.gz"), ("backup", "v1.tar"), ("x.mp4", "abcdefgh.tar"),
+                               ("x.mp4", "abcdefghi.part"))]
     for f in mine:
         f.write_text("mine")
     old = time.time() - 2 * atomic.FOREIGN_STALE_S

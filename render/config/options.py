@@ -242,6 +242,7 @@ def check_npz(out: Path, name: str) -> None:
     check_writable(out.parent, f"--out {out}: its folder")
     check_replaceable(out)
 
+
 def check_replaceable(path: Path, what: str = "--out"):
     """Bad input if `path` is a folder, or a file that is there and cannot be replaced by renaming a finished
     file onto it (render/video/atomic.py), which would fail only after the work. Even root cannot replace an
