@@ -6,6 +6,7 @@ import numpy as np
 
 from conftest import run_cli
 from render.physics import registry
+from render.commands import accuracy
 from render.commands.accuracy import COLUMNS
 from render.config.limits import METHODS
 
@@ -22,6 +23,7 @@ def test_accuracy_quick_writes_tables_and_charts(tmp_path):
     assert "accuracy [" in r.stderr  # progress on stderr
     assert sorted(p.name for p in out.iterdir()) == sorted([*PNGS, "accuracy.csv", "accuracy.md", "quality.md",
                                                                   "summary.md"])
+    assert sorted(accuracy.outputs(registry.names())) == sorted(p.name for p in out.iterdir())  # what it checks
 
     with open(out / "accuracy.csv", newline="") as f:
         reader = csv.DictReader(f)
@@ -61,3 +63,7 @@ def test_accuracy_bad_input_exits_2(tmp_path):
     assert r.returncode == 2 and "--out" in r.stderr and "Traceback" not in r.stderr
     r = run_cli("accuracy", "--system", "chaotic")
     assert r.returncode == 2
+    (tmp_path / "acc" / "summary.md").mkdir(parents=True)  # found before the measurements, not after them
+    r = run_cli("accuracy", "--quick", "--out", tmp_path / "acc", timeout=60)
+    assert r.returncode == 2 and "summary.md: is a folder" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert [p.name for p in (tmp_path / "acc").iterdir()] == ["summary.md"]

@@ -20,7 +20,7 @@ from ..trust import quality
 from ..physics import reference, registry
 from ..physics.stepper import Run
 from ..video.atomic import together, write_atomic
-from ..config.options import check_writable, out_path
+from ..config.options import check_replaceable, check_writable, out_path
 from ..config.limits import METHODS, PRECISIONS
 from ..config.scene import load
 
@@ -258,9 +258,18 @@ def add_parser(sub):
     p.set_defaults(func=run)
 
 
+def outputs(systems) -> list[str]:
+    """The files a run over `systems` writes into --out (the charts named as render/commands/charts.py names them)."""
+    return ["accuracy.csv", "accuracy.md", "summary.md", "quality.md", "divergence.png",
+            *(f"{kind}_{s}.png" for s in systems for kind in ("work_precision", "energy_drift")),
+            f"work_precision_{CHAOS}.png", f"faithful_{CHAOS}.png"]
+
+
 def run(args) -> int:
     check_writable(args.out)
     systems = registry.names() if args.system == "all" else (args.system,)
+    for name in outputs(systems):  # a folder where one goes: refused now, not after minutes of measuring
+        check_replaceable(args.out / name)
     t0, load0 = time.perf_counter(), os.getloadavg()[0]
     rows, energy, chaos, fan_rows, quality_rows = measure(systems, args.arch, args.quick, show=not args.no_progress)
     rows.sort(key=lambda r: (systems.index(r["system"]), METHODS[r["system"]].index(r["method"]),
