@@ -25,7 +25,7 @@ from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
                               out_path, positive_int, progress_wanted, thread_count, usable_cores)
-from ..video.tiled import connect, scheduler_address
+from ..video.tiled import connect, env_address, scheduler_address
 from ..video.version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -141,8 +141,7 @@ def run_dask(scenes, out_root, address, arch, threads, digest):
 
 def run(args) -> int:
     t0 = time.perf_counter()
-    address = scheduler_address(args.scheduler) if args.scheduler is not None else \
-        scheduler_address(os.environ.get("DASK_SCHEDULER_ADDRESS"), "$DASK_SCHEDULER_ADDRESS")
+    address = scheduler_address(args.scheduler) if args.scheduler is not None else env_address()
     jobs_plan = plan(expand_refs(args.presets), args.overrides, parse_sweeps(args.sweep), args.quality)
     check_writable(args.out)
     out_root = args.out.resolve()  # absolute: Dask workers may run elsewhere with another cwd

@@ -104,11 +104,8 @@ def load_preset(preset: str, args):
     return budgeted(load(preset, args.overrides, args.quality), args)
 
 
-ENV_SCHEDULER = "DASK_SCHEDULER_ADDRESS"  # Dask's own variable: the cluster a map renders on without --scheduler
-
-
 def cmd_render(args) -> int:
-    from ..video.tiled import scheduler_address
+    from ..video.tiled import ENV, env_address, scheduler_address
 
     address = scheduler_address(args.scheduler)  # a bad one before any work
     scenes = [load_preset(p, args) for p in args.presets]  # all first
@@ -121,11 +118,10 @@ def cmd_render(args) -> int:
 
     # as for `batch`, Dask's own variable names the cluster: for the maps, which alone can be tiled; checked, with
     # what it asks of each map, before the first render as --scheduler is
-    env = ENV_SCHEDULER if not address and any(s.fractal for s in scenes) else None
-    from_env = scheduler_address(os.environ.get(env), f"${env}") if env else None
+    from_env = env_address() if not address and any(s.fractal for s in scenes) else None
     clusters = [address or (from_env if scene.fractal else None) for scene in scenes]
     for scene, cluster in zip(scenes, clusters):  # every scene's refusals before the first render
-        how = "--scheduler" if address else f"${env}" if cluster else "--tiles" if args.tiles else None
+        how = "--scheduler" if address else f"${ENV}" if cluster else "--tiles" if args.tiles else None
         api.check_render([scene], args.out, how)
     budget.check_run(scenes, args.out)  # and their sum's; the estimate, when over a minute
     for scene, cluster in zip(scenes, clusters):

@@ -129,27 +129,29 @@ def together():
     succeeds, and none is when it fails (their temporaries are removed). A chart written before a failing
     table is not left behind without it."""
     held: list[tuple[Path, Path]] = []
-    published: list[Path] = []
     token = _held.set(held)
     try:
         yield
-        _held.reset(token)
-        token = None
-        for _, path in held:  # the one rename that fails in a folder we could write: onto a folder
-            if path.is_dir() and not path.is_symlink():
-                raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
-        for tmp, path in held:
-            publish(tmp, path)
-            published.append(path)
     except BaseException:
         for tmp, _ in held:
             tmp.unlink(missing_ok=True)
-        for path in published:  # a rename failed after these: this block's files appear together or not at all
-            path.unlink(missing_ok=True)
         raise
     finally:
-        if token is not None:
-            _held.reset(token)
+        _held.reset(token)
+    for _, path in held:  # the one rename that fails in a folder we could write: onto a folder
+        if path.is_dir() and not path.is_symlink():
+            for tmp, _ in held:
+                tmp.unlink(missing_ok=True)
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+    for i, (tmp, path) in enumerate(held):
+        try:
+            publish(tmp, path)
+        except BaseException:  # the files published before it go too: together or not at all
+            for waiting, _ in held[i:]:
+                waiting.unlink(missing_ok=True)
+            for _, published in held[:i]:
+                published.unlink(missing_ok=True)
+            raise
 
 
 def write_atomic(path: Path, data: bytes | str):

@@ -23,14 +23,14 @@ from contextlib import contextmanager
 from ..errors import BatchError, SceneError, SimulationError
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
+ENV = "DASK_SCHEDULER_ADDRESS"  # the cluster `batch` and a map's `render` use without --scheduler
 CONNECT_TIMEOUT = "10s"  # how long Client keeps trying a scheduler (it retries a refused connection till then)
 
 
 def scheduler_address(text: str | None, what: str = "--scheduler") -> str | None:
     """'host:port' or 'tcp://host:port' (any Dask scheme); checked here, since a bad one hangs Client. None for
-    none given; an empty one is refused from the command line (it would quietly render locally), and taken as
-    unset from the environment (`what` names it: "$DASK_SCHEDULER_ADDRESS"), as an empty variable is."""
-    if text is None or (not text.strip() and what.startswith("$")):
+    none given; an empty one is refused (it would quietly render locally). `what` names where it came from."""
+    if text is None:
         return None
     address = text if "://" in text else f"tcp://{text}"
     # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
@@ -40,6 +40,12 @@ def scheduler_address(text: str | None, what: str = "--scheduler") -> str | None
     if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
         raise SceneError(f"{what} {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
     return address
+
+
+def env_address() -> str | None:
+    """The scheduler $DASK_SCHEDULER_ADDRESS (Dask's own variable) names, checked; None where it is unset or
+    empty, as an empty variable is taken by convention."""
+    return scheduler_address(os.environ.get(ENV) or None, f"${ENV}")
 
 
 def connect(address: str):
