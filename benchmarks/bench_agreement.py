@@ -3,7 +3,7 @@ summarised by its median (what `pendulum bench` reports) or by its best round.
 
     python benchmarks/bench_agreement.py [--runs 4] [--env MALLOC_TRIM_THRESHOLD_=1073741824 ...]
 
-Each run is the bench's own sim phase (render/commands/bench_process.py's run_phase: the full ladder, 3
+Each run is the bench's own sim phase (render/commands/bench/process.py's run_phase: the full ladder, 3
 interleaved rounds) in a fresh process, one after the other, as two consecutive `pendulum bench` runs would
 be. For every ratio issue 27 asks to agree within 15 % (ours over numpy and numba, rigid and elastic, f32 and
 f64, and the rigid kernel's rate over the peak's), it prints the value of each run and the range across runs
@@ -19,7 +19,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from render.commands.bench_process import run_phase  # noqa: E402
+from render.commands.bench.process import run_phase  # noqa: E402
 
 SUMMARY = {"median": statistics.median, "best": max}  # of a side's rates over the rounds
 FULL_CPU = SimpleNamespace(arch="cpu", quick=False, repeat=None)  # `pendulum bench`'s defaults

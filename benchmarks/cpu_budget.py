@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/cpu_budget.py [--rounds 3] [--seconds 20]
 
 Runs what `pendulum bench` times for end_to_end_over_encode_floor, rigid_chaos's render and its encode floor
-(render/commands/bench.py's phase_encode, and pipeline.render as its timed_render runs it, after a one-frame
+(render/commands/bench/command.py's phase_encode, and pipeline.render as its timed_render runs it, after a one-frame
 warm-up render), alternating, once a round. For each it prints the wall time, this process's CPU time, its
 ffmpeg children's CPU time (they are waited for inside the span), and the cores' idle time over the span (from
 /proc/stat: the whole machine's, so run it on a quiet one). The floor's span is its Encoder's, from its creation
@@ -26,7 +26,7 @@ from pathlib import Path
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from render.commands import bench  # noqa: E402
+from render.commands.bench import command as bench  # noqa: E402
 from render.video import encode, pipeline  # noqa: E402
 
 

@@ -3,7 +3,7 @@
     python benchmarks/vector_width.py [--widths 0 8 16 32] [--rounds 3] [--renders]
 
 For each width (0: LLVM's own), in its own processes, since LLVM parses its options once per process: the
-rigid RK4 advance at N = 1e5 (steps/s, f64 and f32), the peak kernel of render/commands/peak.py (GFLOPS), the
+rigid RK4 advance at N = 1e5 (steps/s, f64 and f32), the peak kernel of render/commands/bench/peak.py (GFLOPS), the
 time of the first launch of each (compiling, from an empty offline cache) and a hash of the state after 500
 steps from the same start, equal at every width when the arithmetic is. With --renders, also the wall time
 of two short renders (rigid_chaos 5 s and the flip map fractal_flip 2 s, MP4 + GIF, certificate included),
@@ -24,7 +24,7 @@ import time
 def child(prec: str):
     """One process at the width PENDULUM_VECTOR_WIDTH says: a JSON line of its figures."""
     import taichi as ti
-    from render.commands import peak, peers
+    from render.commands.bench import peak, peers
     from render.config.scene import load
     from render.physics import vector_width
     from render.physics.stepper import Run

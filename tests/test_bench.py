@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from render.commands import bench, bench_report, cli, peers
+from render.commands import cli
+from render.commands.bench import command, peers, report
 from render.video import pipeline
 from render.config.scene import load
 
@@ -139,7 +140,7 @@ def test_interleaved_rounds_take_each_side_in_turn():
     assert r == {"value": pytest.approx(2.4), "min": 2.0, "max": 4.0, "spread_pct": pytest.approx(100 * 2 / 2.4),
                  "rounds": 3}
     assert peers.ratio([1.0], None) is None  # a peer that did not run
-    assert bench_report.spread_text(r) == "2..4 (83 %)" and bench_report.with_spread(r) == "**2.40** (2.00..4.00 (83 %))"
+    assert report.spread_text(r) == "2..4 (83 %)" and report.with_spread(r) == "**2.40** (2.00..4.00 (83 %))"
 
 
 def fake_results(numba=True):
@@ -169,7 +170,7 @@ def fake_results(numba=True):
            "hud": {"frames": 118, "ms": 0.8, "rounds_ms": [0.9, 0.8], "spread": peers.spread([0.9, 0.8], 0.8),
                    "size": "1280x720"}, "matplotlib": mpl,
            "rainbow": {"frames": 178, "draw_fps": 40.0, "sim_fps": 300.0, "size": "1280x720", "effects": ["rods"]},
-           **{f"fractal_{c}": {**fractal, "preset": p} for c, p in bench.FRACTALS.items()}}
+           **{f"fractal_{c}": {**fractal, "preset": p} for c, p in command.FRACTALS.items()}}
     for r in res.values():
         r["peak_mem_mb"] = 100.0
     return res
@@ -177,8 +178,8 @@ def fake_results(numba=True):
 
 @pytest.mark.parametrize("kind", ["avx2", "avx512"])
 def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monkeypatch, kind):
-    monkeypatch.setattr(bench_report, "cpu_kind", lambda: kind)
-    rep = bench_report.summarise(fake_results(), True, 1.0, bench.QUICK["chaos_s"], [0.5] * 3)
+    monkeypatch.setattr(report, "cpu_kind", lambda: kind)
+    rep = report.summarise(fake_results(), True, 1.0, command.QUICK["chaos_s"], [0.5] * 3)
     assert rep["machine"]["cpu_kind"] == kind and rep["rounds"] == 2
     assert rep["hud_ms_720p"] == rep["hud_ms_per_frame"] == 0.8
     assert rep["peak_gflops"] == {"f32": 90.0, "f64": 90.0} and rep["peak_flops_f64"] == 90e9
@@ -195,13 +196,13 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
     e2e, rt = t["end_to_end_over_encode_floor"], t["render_over_realtime"]
     assert e2e["value"] == pytest.approx(1.2) and e2e["spread"]["value"] == pytest.approx(1.2)
     assert (e2e["spread"]["min"], e2e["spread"]["max"]) == (pytest.approx(1.0), pytest.approx(1.3 / 0.9))
-    chaos_s = bench.QUICK["chaos_s"]
+    chaos_s = command.QUICK["chaos_s"]
     assert rt["value"] == pytest.approx(1.2 / chaos_s) and rt["spread"]["max"] == pytest.approx(1.3 / chaos_s)
     goal, met, speedup = {"avx2": ("3.5e+07", True, "15"), "avx512": ("5.5e+07", False, "8")}[kind]
     f64 = t["rigid_f64_steps_per_s_1e5"]  # 5e7 steps/s: past AVX2's 3.5e7, short of AVX-512's 5.5e7
     assert f64["goal"] == f">= {goal}" and f64["met"] is met
     assert t["sim_speedup_vs_numpy_1e5"]["goal"] == f">= {speedup}" and t["sim_speedup_vs_numpy_1e5"]["met"]
-    md = bench_report.markdown(rep)
+    md = report.markdown(rep)
     assert "| matplotlib_draw_ratio | 14.1 | 13.3..15 (12 %) |" in md and "**0.278** (0.250..0.300 (18 %))" in md
     assert f"{kind} targets" in md and "load average" in md
     assert "| end-to-end render | 1.20 s (rounds 1.30, 1.10 s) |" in md
@@ -209,20 +210,20 @@ def test_report_carries_each_ratio_with_its_spread_and_targets_by_cpu_kind(monke
 
 
 def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):
-    rep = bench_report.summarise(fake_results(numba=False), True, 1.0, bench.QUICK["chaos_s"], [0.5] * 3)
+    rep = report.summarise(fake_results(numba=False), True, 1.0, command.QUICK["chaos_s"], [0.5] * 3)
     for key in PEER_KEYS:
         assert rep[key] is None and rep["spread"][key] is None
     assert rep["targets"]["sim_speedup_vs_numba_1e5"]["met"] is None
-    assert "null" in bench_report.markdown(rep)
+    assert "null" in report.markdown(rep)
 
 
 def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tmp_path):
     """A phase whose process added a kernel to the offline cache timed its compiles: it runs once more and
-    that run is kept (render/commands/bench_process.py); a phase that found every kernel runs once, and so does
+    that run is kept (render/commands/bench/process.py); a phase that found every kernel runs once, and so does
     every phase of a quick run, whose report says which were timed with compiles."""
     from types import SimpleNamespace
 
-    from render.commands import bench_process
+    from render.commands.bench import process
     from render.physics import vector_width
     cache, runs = tmp_path / "cache", []
     cache.mkdir()
@@ -234,19 +235,19 @@ def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tm
             for k in range(2):
                 (cache / f"T{name}{k}.tic").write_bytes(b"")
         return {"wall_s": 20.0 - len(runs)}
-    monkeypatch.setattr(bench_process, "_run_phase", phase)
+    monkeypatch.setattr(process, "_run_phase", phase)
     full, quick = SimpleNamespace(quick=False, arch="cpu"), SimpleNamespace(quick=True, arch="cpu")
-    assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 18.0, "compiled": 2, "rerun": True}
-    assert bench_process.run_phase("e2e", full, tmp_path) == {"wall_s": 17.0, "compiled": 0, "rerun": False}
-    assert bench_process.run_phase("hud", quick, tmp_path) == {"wall_s": 16.0, "compiled": 2, "rerun": False}
+    assert process.run_phase("e2e", full, tmp_path) == {"wall_s": 18.0, "compiled": 2, "rerun": True}
+    assert process.run_phase("e2e", full, tmp_path) == {"wall_s": 17.0, "compiled": 0, "rerun": False}
+    assert process.run_phase("hud", quick, tmp_path) == {"wall_s": 16.0, "compiled": 2, "rerun": False}
     assert runs == ["e2e", "e2e", "e2e", "hud"]
     res = fake_results()
-    assert "compile" not in bench_report.markdown(bench_report.summarise(res, True, 1.0, 2.0, [0.5] * 3))
+    assert "compile" not in report.markdown(report.summarise(res, True, 1.0, 2.0, [0.5] * 3))
     res["e2e"].update(compiled=2, rerun=True)
     res["hud"].update(compiled=8, rerun=False)
-    rep = bench_report.summarise(res, True, 1.0, 2.0, [0.5] * 3)
+    rep = report.summarise(res, True, 1.0, 2.0, [0.5] * 3)
     assert rep["compiled"] == {"e2e": 2, "hud": 8} and rep["rerun"] == ["e2e"]
-    md = bench_report.markdown(rep)
+    md = report.markdown(rep)
     assert "compiled kernels (how many): e2e (2)." in md and "does not run a phase again): hud (8)." in md
 
 
@@ -258,7 +259,7 @@ def test_repeat_must_be_a_positive_count(capsys, tmp_path):
     assert not list(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("name", bench.FILES)
+@pytest.mark.parametrize("name", command.FILES)
 def test_a_folder_where_a_report_file_goes_is_refused_before_the_bench_runs(capsys, tmp_path, name):
     """Found only when the report is written, it cost a whole bench (6 minutes or more) and left the files
     written before it: refused at once now, and the files are written together (atomic.together)."""

@@ -300,8 +300,8 @@ def test_a_malformed_rates_file_is_ignored(tmp_path, text):
 
 def test_benchs_rates_reproduce_what_it_measured(tmp_path):
     """The rates `pendulum bench` writes (estimate.measured, from its phases' results), read back by a render."""
-    from render.commands import bench
-    chaos = bench.chaos_scene(bench.QUICK)
+    from render.commands.bench import command
+    chaos = command.chaos_scene(command.QUICK)
     rows = [{"system": s, "precision": p, "n": n, "taichi": rate * (1 + n / 1e6)}
             for (s, p), rate in {("rigid", "f64"): 3e7, ("rigid", "f32"): 5e7, ("elastic", "f64"): 9e7,
                                  ("elastic", "f32"): 2e8}.items() for n in (100, 10 ** 5, 10 ** 6)]

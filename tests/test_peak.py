@@ -1,9 +1,9 @@
-"""render/commands/peak.py: the peak-rate kernel computes exactly its chains (nothing skipped, nothing fused), so the
+"""render/commands/bench/peak.py: the peak-rate kernel computes exactly its chains (nothing skipped, nothing fused), so the
 flops it claims are the ones it does."""
 import numpy as np
 import pytest
 
-from render.commands import peak
+from render.commands.bench import peak
 from render.physics import runtime
 
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from render.commands import peers
+from render.commands.bench import peers
 from render.physics import reference
 from render.config.scene import load
 

@@ -29,7 +29,7 @@ from ..config.options import (add_budget, add_common, add_quality, add_render_op
 COMMANDS = {
     "accuracy": ("accuracy", "measure error vs. time of every integrator; charts and tables"),
     "batch": ("batch", "render many presets (default: all) in parallel, locally or on Dask"),
-    "bench": ("bench", "performance report: simulate, draw, encode, end to end, fractal, peers"),
+    "bench": ("bench.command", "performance report: simulate, draw, encode, end to end, fractal, peers"),
     "compare": ("comparison", "one split-screen video of 2 to 4 variants of a preset (OUT/compare/NAME/)"),
     "gallery": ("gallery", "write OUT/index.html: every render in OUT with its video and certificate"),
     "lyapunov": ("lyapunov_cli", "the Lyapunov spectrum of chosen pendulums (OUT/NAME/lyapunov.json)"),

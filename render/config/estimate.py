@@ -231,7 +231,7 @@ def picture_frame_s(scene, rates: dict, panels: int = 0) -> tuple[float, float]:
 
 
 def measured(res: dict, chaos) -> dict:
-    """rates.json from `pendulum bench`'s phases (`res`, render/commands/bench.py): the RK4 rates at the largest N
+    """rates.json from `pendulum bench`'s phases (`res`, render/commands/bench/command.py): the RK4 rates at the largest N
     measured up to 1e5, the triple's scaled as the rigid system's (not benched); the drawing and encoding
     constants scaled so that the model gives the measured fps of `chaos` (the scene the encode phase drew);
     the fixed cost of a one-frame render."""

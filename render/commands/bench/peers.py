@@ -140,7 +140,7 @@ def spread(per: list[float], value: float) -> dict:
 def throughput_keys(rows: list[dict], render_s: float, video_s: float, mpl: dict | None = None) -> dict:
     """Issue 17's report keys from the sim phase's rows at N = 1e5, the timed rigid_chaos render and the
     matplotlib phase; a ratio against a peer that did not run (numba missing) is null. The rows come in
-    bench_sim.SIM_PRESETS' order: the rigid pendulum's system first, then the elastic one's. Their spreads are
+    sim.SIM_PRESETS' order: the rigid pendulum's system first, then the elastic one's. Their spreads are
     in spreads()."""
     rigid, elastic = list(dict.fromkeys(r["system"] for r in rows))[:2]
     at = {(r["system"], r["precision"]): r for r in rows if r["n"] == 10**5}
@@ -221,7 +221,7 @@ def matplotlib_figure(scene):
     import numpy as np
     from matplotlib.collections import LineCollection
 
-    from ..physics import reference, registry
+    from ...physics import reference, registry
 
     plan = registry.get(scene.system)(scene)  # the step and the initial state, no Taichi
     q, v = (a.T.copy() for a in reference.initial_state(scene))
@@ -267,7 +267,7 @@ def matplotlib_render(scene, out_file) -> float:
     import matplotlib.pyplot as plt
     from matplotlib.animation import FFMpegWriter, FuncAnimation
 
-    from ..video import mp4
+    from ...video import mp4
 
     t0 = time.perf_counter()
     fig, frame = matplotlib_figure(scene)

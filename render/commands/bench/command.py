@@ -1,10 +1,10 @@
 """`pendulum bench`: how close a render comes to the encoder's floor, simulation vs numpy, and the fractal.
 
-Every phase runs in its own subprocess (a fresh Taichi runtime: render/commands/bench_process.py) while this
+Every phase runs in its own subprocess (a fresh Taichi runtime: render/commands/bench/process.py) while this
 process samples the resident memory of that process tree (ffmpeg included), so all figures of one report come
 from one run. Precision is fixed per Taichi init, so the simulation phase runs f32, then f64. Every ratio
-against a peer (numpy, numba, matplotlib, the peak rate of render/commands/peak.py) comes from --repeat
-interleaved rounds (render/commands/peers.py) and is reported with its spread over them. Method and findings:
+against a peer (numpy, numba, matplotlib, the peak rate of render/commands/bench/peak.py) comes from --repeat
+interleaved rounds (render/commands/bench/peers.py) and is reported with its spread over them. Method and findings:
 benchmarks/README.md.
 """
 from __future__ import annotations
@@ -21,14 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import estimate
+from ...config import estimate
 from . import peers
-from .bench_process import maxrss_mb, run_phase
-from .bench_sim import phase_sim
-from .bench_report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
-from ..video.atomic import together, write_atomic
-from ..config.options import check_replaceable, check_writable, out_path, positive_int
-from ..physics import vector_width
+from .process import maxrss_mb, run_phase
+from .sim import phase_sim
+from .report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
+from ...video.atomic import together, write_atomic
+from ...config.options import check_replaceable, check_writable, out_path, positive_int
+from ...physics import vector_width
 
 CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
 FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fractal_divergence",
@@ -119,7 +119,7 @@ def run(args) -> int:
 # ---------------------------------------------------------------- phases
 
 def chaos_scene(cfg):
-    from ..config.scene import load
+    from ...config.scene import load
     return load(CHAOS, [f"video.duration={cfg['chaos_s']}"])
 
 
@@ -129,9 +129,9 @@ def phase_encode(cfg, arch, tmp) -> dict:
     through the same Encoder: the floor an end-to-end render cannot beat. Until 2026-12-04 the floor fed the GIF
     the video's frames, which the Encoder then area-averaged in numpy (3.1 s of this process's CPU beside the
     encoders on the 2-core Xeon): work no render does, so the floor was higher than the encoders alone."""
-    from ..video import pipeline
-    from ..video.encode import Encoder
-    from ..video.gif import Frames
+    from ...video import pipeline
+    from ...video.encode import Encoder
+    from ...video.gif import Frames
 
     scene = chaos_scene(cfg)
     src = pipeline.Source(scene, arch)
@@ -176,7 +176,7 @@ def phase_encode(cfg, arch, tmp) -> dict:
 
 def timed_render(scene, arch, tmp, warm_scene=None) -> tuple[float, dict]:
     """Wall time of pipeline.render, after a warm-up render (Taichi init, kernel cache); and its metadata."""
-    from ..video import pipeline
+    from ...video import pipeline
     if warm_scene is not None:
         pipeline.render(warm_scene, tmp / "warm", arch=arch)
     t = time.perf_counter()
@@ -203,7 +203,7 @@ def phase_fractal(colouring, cfg, arch, tmp) -> dict:
     timed render finds the same systems built (render/physics/stepper.py) and its kernels in Taichi's cache: a
     smaller warm-up would compile other kernels, since a map's size is a constant of them. The quick one, a
     smoke test, times the compiles too."""
-    from ..config.scene import load
+    from ...config.scene import load
     name, seconds = FRACTALS[colouring], cfg["fractal_s"][colouring]
     scene = load(name, SIZE + ([f"video.duration={seconds}"] if seconds else []))
     warm = None if not cfg["warm_maps"] else scene.replace(video={"duration": 1.0 / scene.video.fps})
@@ -217,9 +217,9 @@ def phase_rainbow(cfg, arch, tmp) -> dict:
     """Drawing fps of rainbow_1000 (1000 pendulums, glow, 720p) over its whole video, the spray included (the
     quick run: its first 3 s, still coherent), timed per frame like the encode phase: frames 0 and 1
     instantiate kernels."""
-    from ..physics.stepper import Run
-    from ..draw.canvas import Canvas
-    from ..config.scene import load
+    from ...physics.stepper import Run
+    from ...draw.canvas import Canvas
+    from ...config.scene import load
 
     scene = load(RAINBOW, [f"video.duration={cfg['rainbow_s']}"] if cfg["rainbow_s"] else [])
     run = Run(scene, arch)
@@ -250,8 +250,8 @@ def phase_hud(cfg, arch, tmp) -> dict:
     about one wake-up of the thread pool (render/physics/runtime.py), so one round's median moved 21 % between two
     runs of the same code."""
     import taichi as ti
-    from ..physics.stepper import Run
-    from ..draw.hud import Hud, Info
+    from ...physics.stepper import Run
+    from ...draw.hud import Hud, Info
 
     scene = chaos_scene(cfg)
     run = Run(scene, arch)
@@ -275,8 +275,8 @@ def phase_hud(cfg, arch, tmp) -> dict:
 def draw_timer(scene, arch):
     """once(): frames per second of simulating and drawing all the scene's frames, nothing encoded, from the
     start each time (the first call compiles)."""
-    from ..physics.stepper import Run
-    from ..draw.canvas import Canvas
+    from ...physics.stepper import Run
+    from ...draw.canvas import Canvas
 
     built = {}
 
@@ -300,7 +300,7 @@ def phase_matplotlib(cfg, arch, tmp) -> dict:
     """rigid_chaos by ours and by the matplotlib peer, the same frames, in interleaved rounds: to MP4, our render
     against FuncAnimation's save (issue 17), and drawn only, our simulate + draw against the peer's canvas.draw
     (issue 27). Rates are per second (1 / wall for a render, frames / s for drawing)."""
-    from ..config.scene import load
+    from ...config.scene import load
     scene = load(CHAOS, [f"video.duration={cfg['peer_s']}", 'video.formats=["mp4"]'])
     one = scene.replace(video={"duration": 1.0 / scene.video.fps})
     timed_render(one, arch, tmp)  # compiles; and the peer's imports are paid before its first round

@@ -1,6 +1,6 @@
 """One phase of `pendulum bench` in its own process, and the peak memory of that process and its children.
 
-Apart from render/commands/bench.py, which chooses and times the phases: a phase runs as a fresh Taichi runtime
+Apart from render/commands/bench/command.py, which chooses and times the phases: a phase runs as a fresh Taichi runtime
 (`python -m render bench --phase NAME`), and what it costs in memory is read from outside it, from /proc, since
 its ffmpeg children count too.
 """
@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..errors import SimulationError
+from ...errors import SimulationError
 
 
 def run_phase(name: str, args, tmp: Path) -> dict:
@@ -19,7 +19,7 @@ def run_phase(name: str, args, tmp: Path) -> dict:
     how many kernels it compiled (Taichi's offline cache gained a file: it writes them when the process ends).
     Then, unless --quick (a smoke run), the phase runs once more and that run is kept (`rerun`): its warm-ups
     cannot load what the timed part compiles, since a kernel's cache key holds every field made before it in
-    the process (render/commands/bench.py's e2e phase)."""
+    the process (render/commands/bench/command.py's e2e phase)."""
     before = cached_kernels(args.arch)
     out = _run_phase(name, args, tmp)
     compiled = len(cached_kernels(args.arch) - before)
@@ -32,7 +32,7 @@ def run_phase(name: str, args, tmp: Path) -> dict:
 
 def cached_kernels(arch: str) -> set[str]:
     """The kernels in the offline cache the phases' processes on `arch` use (empty if it does not exist yet)."""
-    from ..physics import vector_width
+    from ...physics import vector_width
     try:
         return {f for f in os.listdir(vector_width.cache_folder(arch)) if f.endswith(".tic")}
     except OSError:

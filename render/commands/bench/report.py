@@ -1,4 +1,4 @@
-"""What a `pendulum bench` run reports (render/commands/bench.py runs the phases): report.json's figures and
+"""What a `pendulum bench` run reports (render/commands/bench/command.py runs the phases): report.json's figures and
 the targets they are held to, report.md, and targets.md, the table docs/performance.md shows."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 from . import peers
-from ..physics import vector_width
+from ...physics import vector_width
 
 # Issue 27's table (the older issues' targets it does not restate kept); a goal given per CPU kind (cpu_kind():
 # AVX-512's wider vectors speed numpy's sin/cos as much as ours, so the ratios to the peers are lower there).
@@ -29,9 +29,9 @@ TARGETS = [("render_over_realtime", "<=", 0.6), ("end_to_end_over_encode_floor",
 
 
 def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start: list[float]) -> dict:
-    """report.json from the phases' results `res` (render/commands/bench.py): a run of `wall` seconds whose
+    """report.json from the phases' results `res` (render/commands/bench/command.py): a run of `wall` seconds whose
     end-to-end render was `chaos_s` seconds of video, with the machine's load average at its start."""
-    from ..video.encode import ffmpeg_version
+    from ...video.encode import ffmpeg_version
 
     at = {f"{r['system']}_{r['precision']}": r["speedup"] for r in res["sim"]["rows"] if r["n"] == 10**5}
     headline = f"{res['sim']['rows'][0]['system']}_f64"
@@ -196,7 +196,7 @@ def markdown(r: dict) -> str:
                    "" if s["n"] != 10**5 else fmt(s["numba"] and s["numba"] / 1e6, ".2f"),
                    "" if s["n"] != 10**5 else with_spread(s["vs"]["numba"]), f"{s['agree']:.1e}"]
                   for s in r["sim"]])
-    out += ["", "## Peak floating-point rate (render/commands/peak.py) and the rigid RK4 kernel's share of it "
+    out += ["", "## Peak floating-point rate (render/commands/bench/peak.py) and the rigid RK4 kernel's share of it "
             "(N=1e5)", ""]
     out += table(["precision", "peak GFLOP/s", "flops per RK4 step", "rigid RK4 GFLOP/s", "fraction of peak (range)"],
                  [[p, f"{v['peak_gflops']:.1f}", v["flops_per_step"], f"{v['rigid_rk4_gflops']:.1f}",

@@ -1,16 +1,16 @@
 """The bench's simulation phase: our RK4 kernels against the numpy-vectorised peer (and numba's at N = 1e5), and
-the rigid kernel against the machine's peak rate (render/commands/peak.py), over a ladder of pendulum counts in
+the rigid kernel against the machine's peak rate (render/commands/bench/peak.py), over a ladder of pendulum counts in
 f32 and f64.
 
-Apart from render/commands/bench.py, which runs the phases and times the renders, because this one measures
-kernels, not files: steps per second, each side timed in the same interleaved rounds (render/commands/peers.py).
+Apart from render/commands/bench/command.py, which runs the phases and times the renders, because this one measures
+kernels, not files: steps per second, each side timed in the same interleaved rounds (render/commands/bench/peers.py).
 """
 import statistics
 
 import numpy as np
 
 from . import peak, peers
-from ..physics import reference
+from ...physics import reference
 
 SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the first gives the headline figure
 
@@ -18,10 +18,10 @@ SIM_PRESETS = ("rigid_chaos", "elastic_fan")  # one per system measured; the fir
 def phase_sim(cfg, arch, tmp) -> dict:
     """Pendulum-substeps per second of the Taichi kernel and of the numpy baseline, same RK4, same state, in
     interleaved rounds; at N = 1e5 the numba peer too, and for the rigid kernel the peak rate of
-    render/commands/peak.py, whose ratio to the kernel's flop rate is rigid_rk4_peak_fraction."""
+    render/commands/bench/peak.py, whose ratio to the kernel's flop rate is rigid_rk4_peak_fraction."""
     import taichi as ti
-    from ..physics.stepper import Run
-    from ..config.scene import load
+    from ...physics.stepper import Run
+    from ...config.scene import load
 
     rows, peaks = [], {}
     for prec in ("f32", "f64"):

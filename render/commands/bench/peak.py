@@ -22,7 +22,7 @@ rate as FMAs; on a CPU that runs both on its FMA ports it is half the FMA peak.
 import taichi as ti
 
 from . import peers
-from ..physics import runtime
+from ...physics import runtime
 
 CHAINS, UNROLL = 12, 8
 LANES = {"f64": 16, "f32": 32}  # 4 AVX2 registers of lanes either way (System.CHUNK)
