@@ -49,9 +49,10 @@ def test_accelerations_and_energy_match_the_chain_reference_at_random_states():
     np.testing.assert_allclose(e, reference.chain_energy(q, v, p), rtol=1e-12, atol=1e-10)
 
 
+@pytest.mark.parametrize("damping", [0.0, 0.7])
 @pytest.mark.parametrize("method, tol", [("rk4", 2e-7), ("implicit_midpoint", 1e-3)])
-def test_trajectories_match_dop853(method, tol):
-    scene = triple(method=method)
+def test_trajectories_match_dop853(method, tol, damping):
+    scene = triple(method=method, damping=damping)
     sim = run(scene)
     q_ref, v_ref = reference.solve(scene, reference.initial_state(scene), sim.t, rtol=1e-12, atol=1e-12)
     err = np.abs(sim.q.to_numpy() - q_ref).max()

@@ -43,9 +43,17 @@ def symplectic_euler(sys: ti.template(), q, v, h):
 
 @ti.func
 def verlet(sys: ti.template(), q, v, h):
+    """Velocity Verlet. Damping −c·v is the one force that depends on v on the systems that offer it: the
+    opening kick takes it at the step's start and the closing kick at its end, solved for exactly, so the
+    damping is integrated by the trapezoidal rule and the step stays second order and symmetric (Yoshida's
+    composition reaches order 4 only from a symmetric step). Taken at mid-step velocities, as a plain closing
+    kick would, it was first order: elastic_fan damped 0.7 1/s, 1.6e-4 off DOP853 after 1 s at dt 5e-4."""
     v += 0.5 * h * sys.force(q, v)
     q += h * v
-    return q, v + 0.5 * h * sys.force(q, v)
+    half = 0.5 * h
+    if ti.static(sys.damped):
+        half = 0.5 * h / (1.0 + 0.5 * h * sys.damping)
+    return q, v + half * sys.force(q, v)
 
 
 @ti.func
