@@ -62,13 +62,23 @@ def gallery(tmp_path_factory):
     r = run_cli("compare", "rigid_chaos", "--vary", "integrator.precision=f32,f64", *vary, "--out", out,
                 "--no-progress")
     assert r.returncode == 0, r.stderr
+    r = run_cli("render", "fractal_flip", *(a for s in ["video.duration=0.5", *SMALL] for a in ("--set", s)),
+                "--out", out, "--no-progress")  # a map: metadata.json's energy is null
+    assert r.returncode == 0, r.stderr
     r = run_cli("gallery", "--out", out)
     assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("3 render(s) ->"), r.stdout  # none skipped
     metas = {"render": json.loads((out_folder(out, "classic") / "metadata.json").read_text()),
-             "compare": json.loads((out_folder(out / "compare", "rigid_chaos") / "metadata.json").read_text())}
+             "compare": json.loads((out_folder(out / "compare", "rigid_chaos") / "metadata.json").read_text()),
+             "map": json.loads((out_folder(out, "fractal_flip") / "metadata.json").read_text())}
     page = cards((out / "index.html").read_text())
-    return metas, {"render": Card(page[metas["render"]["preset"]["name"]]),
-                   "compare": Card(page[metas["compare"]["preset"]["name"]])}
+    return metas, {key: Card(page[meta["preset"]["name"]]) for key, meta in metas.items()}
+
+
+def test_a_map_gets_a_card_and_its_energy_reads_not_measured(gallery):
+    metas, found = gallery
+    assert metas["map"]["energy"] is None and "map" in metas["map"]
+    assert found["map"].rows["energy drift"] == "not measured", found["map"].rows
 
 
 def test_metadata_records_the_overrides_as_given_and_the_card_shows_each(gallery):

@@ -23,9 +23,10 @@ from ..video.files import Refused, kind, read_regular
 
 META_MAX_BYTES = 1 << 20  # 1 MiB; a render's metadata.json is a few kB (a histogram replaces long per-pendulum lists)
 INT_DIGITS_MAX = 18  # every count and byte size a render records fits in int64; 10**400 fits no float
-# The sections a card reads, and the type each must have when present (metadata from older versions may lack some).
-SECTIONS = {"preset": dict, "integrator": dict, "energy": dict, "timings_s": dict, "versions": dict,
-            "faithfulness": dict, "outputs": dict, "outputs_sha256": dict}
+# The sections a card reads, each an object when present (metadata from older versions may lack some); those in
+# NULLABLE may be null too: "energy" is, wherever the energy effect is off, as on every map.
+SECTIONS = ("preset", "integrator", "energy", "timings_s", "versions", "faithfulness", "outputs", "outputs_sha256")
+NULLABLE = ("energy",)
 
 
 def folder(root: Path, path: Path) -> Path:
@@ -81,14 +82,15 @@ def read_json(path: Path):
 
 
 def metadata(where: Path) -> tuple[dict, dict[str, Path]]:
-    """A render folder's metadata (of the shape SECTIONS gives) and its outputs that are still there
+    """A render folder's metadata (its SECTIONS objects, or null where NULLABLE) and its outputs that are still there
     (name -> path, each checked by member)."""
     meta = read_json(Path(where) / "metadata.json")
     if not isinstance(meta, dict):
         raise Refused(f"metadata.json holds {_json_kind(meta)}, not an object")
-    for key, kind in SECTIONS.items():
-        if key in meta and not isinstance(meta[key], kind):
-            raise Refused(f"metadata.json: {key} is {_json_kind(meta[key])}, not an object")
+    for key in SECTIONS:
+        if key in meta and not isinstance(meta[key], dict) and not (key in NULLABLE and meta[key] is None):
+            raise Refused(f"metadata.json: {key} is {_json_kind(meta[key])}, not an object"
+                          f"{' or null' if key in NULLABLE else ''}")
     outputs = meta.get("outputs", {})
     for name, size in outputs.items():
         if not isinstance(size, int) or isinstance(size, bool) or size < 0:

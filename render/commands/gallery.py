@@ -158,7 +158,8 @@ def row_from_meta(name: str, status: str, meta: dict, wall_s: float | None) -> d
 
 def card(r: Found, rel: Path) -> str:
     """One render's card, or the note of why it is skipped; links go to `rel`, its folder relative to the page.
-    `r` is as find_renders checked it: each section of the shape confined.SECTIONS gives, each file inside."""
+    `r` is as find_renders checked it: each section of confined.SECTIONS an object (or null where
+    confined.NULLABLE), each file inside."""
     if r.skipped:
         return f'<div class="card"><h2>{_e(rel.as_posix())}</h2><div class="skip">skipped: {_e(r.skipped)}</div></div>'
     meta, preset = r.meta, r.meta.get("preset", {})
