@@ -323,3 +323,16 @@ def test_an_unexpected_error_is_one_line_and_debug_shows_the_traceback(tmp_path)
                       (args, {**os.environ, "PENDULUM_DEBUG": "1"})):
         r = run_cli(*argv, cwd=tmp_path, timeout=60, preexec_fn=tight, env=env)
         assert r.returncode == 1 and "Traceback" in r.stderr and r.stderr.strip().splitlines()[-1] == line
+
+
+def test_an_unwritable_kernel_cache_is_replaced_with_one_warning_not_a_crash(tmp_path):
+    """Taichi 1.7.4 segfaults at exit where its cache folder cannot be made ($HOME read-only or missing): exit
+    139 after the file was written. The run caches under the temporary folder instead and says so."""
+    env = {k: v for k, v in os.environ.items() if k not in ("TI_OFFLINE_CACHE_FILE_PATH", "XDG_CACHE_HOME")}
+    (tmp_path / "tmp").mkdir()
+    env.update(HOME="/proc/no-such-home", TMPDIR=str(tmp_path / "tmp"))
+    r = run_cli("simulate", "classic", "--out", tmp_path / "c.npz", *TINY, env=env)
+    assert r.returncode == 0, (r.returncode, r.stderr)
+    [line] = r.stderr.splitlines()
+    assert line.startswith("warning: Taichi's kernel cache /proc/no-such-home/") and str(tmp_path / "tmp") in line
+    assert (tmp_path / "c.npz").exists() and any((tmp_path / "tmp").iterdir())

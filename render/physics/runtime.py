@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
+import stat
 import sys
+import tempfile
 import warnings
 
 import taichi as ti
@@ -60,6 +63,7 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, 
               random_seed=0, offline_cache=True, fast_math=False)
     if threads:
         kw["cpu_max_num_threads"] = threads
+    writable_cache()
     if arch == "cpu":  # before the first kernel compiles: LLVM reads its options then
         vector_width.apply()
     # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
@@ -74,6 +78,26 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, 
     launched.clear()
     allocated.clear()
     return used
+
+
+def writable_cache():
+    """Taichi 1.7.4 segfaults as the process exits, after a run has succeeded, where its offline cache's
+    folder cannot be made (a read-only or missing $HOME, as in some containers): exit code 139 for a finished
+    render. Such a process caches its kernels in a folder of its own under the temporary folder, and says so."""
+    root = vector_width.cache_root()
+    with contextlib.suppress(OSError):
+        os.makedirs(root, exist_ok=True)
+    if os.access(root, os.W_OK | os.X_OK):
+        return
+    spare = os.path.join(tempfile.gettempdir(), f"pendulum-taichi-cache-{os.getuid()}")
+    with contextlib.suppress(FileExistsError):
+        os.mkdir(spare, 0o700)
+    mode = os.lstat(spare)
+    if not stat.S_ISDIR(mode.st_mode) or mode.st_uid != os.getuid():  # a shared temporary folder: not ours
+        spare = tempfile.mkdtemp(prefix="pendulum-taichi-cache-")
+    os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = spare
+    print(f"warning: Taichi's kernel cache {root} cannot be written; caching kernels in {spare} "
+          f"(TI_OFFLINE_CACHE_FILE_PATH chooses the folder)", file=sys.stderr)
 
 
 def generation() -> int:

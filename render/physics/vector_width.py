@@ -187,12 +187,13 @@ def _own_cache(sub: str):
     os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = _in_cache(sub)
 
 
-def _cache_root() -> str:
+def cache_root() -> str:
+    """Taichi's offline cache folder as this process's environment sets it, else Taichi's default."""
     return os.environ.get("TI_OFFLINE_CACHE_FILE_PATH") or ti.lang.impl.default_cfg().offline_cache_file_path
 
 
 def _in_cache(sub: str) -> str:
-    path = _cache_root()
+    path = cache_root()
     return path if os.path.basename(os.path.normpath(path)) == sub else os.path.join(path, sub)
 
 
@@ -200,4 +201,4 @@ def cache_folder(arch: str = "cpu") -> str:
     """The folder Taichi's offline cache writes this process's kernels to, or a child's it starts on `arch`:
     apply()'s subfolder where it sets a width (runtime.init applies it on the CPU only), else the cache itself."""
     width = planned() if arch == "cpu" else 0
-    return _in_cache(f"llvm-vf{width}") if width else _cache_root()
+    return _in_cache(f"llvm-vf{width}") if width else cache_root()
