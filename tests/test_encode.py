@@ -138,3 +138,20 @@ def test_a_gif_frame_of_the_wrong_size_is_refused(tmp_path):
         enc.write(np.zeros((54, 96, 3), np.uint8), np.zeros((54, 96, 3), np.uint8))
     enc.abort()
     assert not list(tmp_path.iterdir())
+
+
+def test_an_ffmpeg_failure_names_its_cause_not_only_where_it_stopped(tmp_path, monkeypatch):
+    """At -loglevel error an ffmpeg that lacks a filter logs the cause first ("No such filter") and last only
+    what it stopped: the message carries both (an ffmpeg 4.2 without addroi had said only the last)."""
+    from render.config.scene import load
+    from render.video import mp4
+    monkeypatch.setattr(mp4, "roi", lambda video: ["-vf", "nosuchfilter"])
+    v = load("classic", ["video.width=64", "video.height=36", "video.duration=0.1"]).video
+    enc = encode.Encoder(tmp_path, "broken", v, 6, formats=["mp4"])
+    with pytest.raises(encode.EncodeError) as failed:
+        for _ in range(6):
+            enc.write(np.zeros((36, 64, 3), np.uint8))
+        enc.close()
+    message = str(failed.value)
+    assert "No such filter: 'nosuchfilter'" in message and len(message.splitlines()) == 1, message
+    assert not any(tmp_path.iterdir())

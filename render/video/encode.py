@@ -47,6 +47,12 @@ def os_error(log: str) -> int | None:
     return min(found)[1] if found else None
 
 
+def _ends(log: str) -> str:
+    """An ffmpeg log's first and last lines, or its one line."""
+    lines = [line.strip() for line in log.splitlines() if line.strip()]
+    return lines[0] if len(lines) == 1 else f"{lines[0]} ... {lines[-1]}"
+
+
 class _Still:
     """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
 
@@ -288,13 +294,15 @@ class Encoder:
     def _failure(self, how: str, fallback) -> Exception:
         """What to raise when an ffmpeg process failed: the OS's reason and the file when the file system
         failed it (OSError, e.g. "No space left on device: out/NAME/NAME.mp4"), else EncodeError with the
-        last line of each ffmpeg's log."""
+        first and last line of each ffmpeg's log: at -loglevel error the first names the cause ("No such
+        filter: 'addroi'", from an ffmpeg too old), the last only what it stopped ("Error while processing the
+        decoded data for stream #0:0")."""
         logs = [self._log(t) for t in self.targets]
         for t, log in zip(self.targets, logs):
             code = os_error(log)
             if code is not None:
                 return OSError(code, os.strerror(code), str(t.final))
-        return EncodeError(f"ffmpeg {how}: {' | '.join(x.splitlines()[-1] for x in logs if x) or fallback}")
+        return EncodeError(f"ffmpeg {how}: {' | '.join(_ends(x) for x in logs if x.strip()) or fallback}")
 
     @staticmethod
     def _log(t: _Target) -> str:
