@@ -49,7 +49,9 @@ class Parser(argparse.ArgumentParser):
 def build_parser(argv=()) -> argparse.ArgumentParser:
     """The parser for the command line `argv`: complete for the command it gives, the others only listed."""
     p = Parser(prog="pendulum", description="Double-pendulum presets to MP4 and GIF, simulated with Taichi.",
-               epilog="Presets live in presets/*.toml; see docs/presets.md for the format.")
+               epilog="Presets: `pendulum presets` lists them. Your own are found in the folders of "
+                      "$PENDULUM_PRESETS, then in ./presets/, before those shipped with the package; their "
+                      "format: docs/presets.md in the repository.")
     p.add_argument("--debug", action="store_true", help="on an error, print the traceback too "
                    "(or set PENDULUM_DEBUG=1)")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)

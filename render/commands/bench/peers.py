@@ -22,7 +22,8 @@ try:
 except ImportError:  # the bench says so once and writes null
     numba = None
 
-MISSING = "numba is not installed (pip install -e '.[bench]'): the numba peer is skipped, its keys are null"
+MISSING = ("numba is not installed (pip install 'taichi-pendulum[bench]', or in a checkout pip install -e "
+           "'.[bench]'): the numba peer is skipped, its keys are null")
 
 
 def numba_rk4(scene, dtype):
