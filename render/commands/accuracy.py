@@ -274,8 +274,7 @@ def run(args) -> int:
     rows, energy, chaos, fan_rows, quality_rows = measure(systems, args.arch, args.quick, show=not args.no_progress)
     rows.sort(key=lambda r: (systems.index(r["system"]), METHODS[r["system"]].index(r["method"]),
                              r["precision"] != "f64", -r["dt"]))
-    args.out.mkdir(parents=True, exist_ok=True)
-    with together():  # the charts and tables appear together: a failure leaves none of them
+    with together(args.out):  # the charts and tables appear together: a failure leaves none of them
         charts.accuracy_charts(args.out, rows, energy, chaos, {s: CASES[s] for s in systems}, UNITS, FPS, LONG_DT,
                                CHAOS_FPS)
         write_atomic(args.out / "accuracy.csv", csv_text(rows).encode())

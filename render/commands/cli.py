@@ -168,6 +168,8 @@ def cmd_presets(args) -> int:
     return 0
 
 
+# Distributions whose import name differs: what `pip install` takes for a module found missing.
+DISTRIBUTIONS = {"dask": "dask[distributed]", "distributed": "dask[distributed]", "imageio_ffmpeg": "imageio-ffmpeg"}
 RESEND_S = 0.005  # a signal lost in a finalizer comes again this much later: the finalizer has returned by then
 
 
@@ -223,6 +225,13 @@ def main(argv=None) -> int:
         return fail(1, "failed", f"{e.strerror or e}{where}", debug)
     except MemoryError as e:
         return fail(1, "failed", f"out of memory ({e or 'MemoryError'})", debug)
+    except ModuleNotFoundError as e:  # a dependency missing where it is imported lazily (a partial install)
+        top = (e.name or "").partition(".")[0]
+        if not top or top == __package__.partition(".")[0]:  # one of ours missing is a bug: below
+            return fail(1, "unexpected error", f"{e} (run with --debug for the traceback)", debug)
+        need = DISTRIBUTIONS.get(top, top)
+        return fail(1, "failed", f"this needs the Python package {need}, which is not installed here: "
+                                 f"pip install '{need}'", debug)
     except Exception as e:  # noqa: BLE001 - a bug or an unforeseen fault: still one line, not a traceback
         why = f"{type(e).__name__}: {e}".rstrip(": ")
         return fail(1, "unexpected error", f"{why} (run with --debug for the traceback)", debug)

@@ -77,9 +77,8 @@ def run(args) -> int:
     check_out_folder(scene, args.out, FILES)  # a file, a symlink or a folder where these go: before the work
     out_dir = scene.out_dir(args.out)
     doc, run_ = lyapunov.measure(scene, pendulums, args.arch, args.threads, progress_wanted(args))
-    out_dir.mkdir(parents=True, exist_ok=True)
     png, js = (out_dir / f for f in FILES)
-    with together():  # the chart only with its numbers
+    with together(out_dir):  # the chart only with its numbers
         charts.lyapunov_chart(png, run_["t"], run_["running"], [int(i) for i in pendulums], scene.name,
                               doc["pendulums"][0]["checks"]["expected_sum"])
         write_atomic(js, json.dumps(doc, indent=2) + "\n")

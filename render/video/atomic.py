@@ -7,6 +7,7 @@ exists; from another host sharing the folder (a Dask cluster), where liveness ca
 only after FOREIGN_STALE_S without a write. A live writer's file is never touched, and neither is a folder
 reached through a symlink at its end: that may lead out of the output folder, to files not ours to judge.
 """
+import contextlib
 import contextvars
 import errno
 import hashlib
@@ -123,11 +124,27 @@ def naming(path: Path):
 
 
 @contextmanager
-def together():
+def together(folder: Path | None = None):
     """A command's files appear together or not at all: within the block, each file replacing() and
     write_atomic() finish stays in its temporary; all are published, in the order written, when the block
     succeeds, and none is when it fails (their temporaries are removed). A chart written before a failing
-    table is not left behind without it."""
+    table is not left behind without it. `folder`, where they go, is made here if missing, and removed again
+    if the block fails and leaves it empty: a failed command leaves no empty folder behind either."""
+    made = folder is not None and not os.path.lexists(folder)
+    if folder is not None:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+    try:
+        with _together():
+            yield
+    except BaseException:
+        if made:
+            with contextlib.suppress(OSError):  # not empty: something else was put there meanwhile
+                Path(folder).rmdir()
+        raise
+
+
+@contextmanager
+def _together():
     held: list[tuple[Path, Path]] = []
     token = _held.set(held)
     try:

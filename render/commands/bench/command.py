@@ -95,8 +95,7 @@ def run(args) -> int:
             res[name] = run_phase(name, args, Path(tmp))
     report = summarise(res, args.quick, time.perf_counter() - t0, cfg["chaos_s"], load)
     print(f"bench: load average {load_text(report['machine']['load_avg_end'])} at the end", file=sys.stderr)
-    args.out.mkdir(parents=True, exist_ok=True)
-    with together():  # the report, the rates and the table appear together, or none of them
+    with together(args.out):  # the report, the rates and the table appear together, or none of them
         write_atomic(args.out / "report.json", (json.dumps(report, indent=2) + "\n").encode())
         write_atomic(args.out / "report.md", markdown(report).encode())
         # This machine's rates for the run-time budget of renders into the OUT above (render/config/estimate.py)
