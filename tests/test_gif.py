@@ -259,3 +259,20 @@ def test_the_rainbow_gif_keeps_the_videos_hues(tmp_path):
     path, mp4 = render(scene, tmp_path)[:2]
     d = hue_distance(hue_histogram(iio.imiter(mp4)), hue_histogram(iio.imiter(path)))
     assert d < HUE_LIMIT, d
+
+
+def test_a_gif_of_the_videos_size_and_rate_keeps_every_frame(tmp_path):
+    """Such a GIF takes the video's own frames, into which a render draws the next frame: each is kept as it
+    was handed over (all had been the last one, and the palette was sampled from frames being redrawn)."""
+    scene = load("classic", ["video.width=160", "video.height=90", "video.fps=10", "video.duration=2",
+                             'video.formats=["mp4", "gif"]'])
+    path, _, _, small = render(scene, tmp_path)
+    decoded = iio.imread(path, index=None)[..., :3]
+    assert len(decoded) == len(small) == scene.frames
+    last = small[scene.frames - 1]
+    for i, frame in small.items():
+        assert psnr(decoded[i], frame) > 30, i
+        if psnr(frame, last) < 30:  # a frame unlike the last one: the GIF's is not the last one either
+            assert psnr(decoded[i], last) < psnr(decoded[i], frame), i
+    again, _, _, _ = render(scene, tmp_path / "again", threads=2)
+    assert again.read_bytes() == path.read_bytes()

@@ -88,11 +88,13 @@ def _columns(rows: ti.types.ndarray(dtype=ti.i32, ndim=1), out: ti.types.ndarray
 
 
 def shrink(frame: np.ndarray, w: int, h: int) -> np.ndarray:
-    """An H×W×3 uint8 frame area-averaged down to h×w (see the module's docstring); the frame itself if it is
-    that size already. Taichi must run: a Run starts it (render/physics/stepper.py)."""
+    """An H×W×3 uint8 frame area-averaged down to h×w (see the module's docstring), a new array; a copy if it
+    is that size already, since the GIF keeps what this gives past the frame, which a render draws the next
+    frame into (a GIF of the video's size and rate was every frame the last one). Taichi must run: a Run
+    starts it (render/physics/stepper.py)."""
     H, W = frame.shape[:2]
     if (H, W) == (h, w):
-        return frame
+        return frame.copy()
     if runtime.generation() == 0:
         raise RuntimeError("downscale.shrink: Taichi is not running (a Run starts it)")
     fy, sy = shares(H, h)
