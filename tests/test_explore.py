@@ -80,7 +80,10 @@ def test_the_explorer_without_a_window(tmp_path):
     assert np.allclose([xlo, xhi, ylo, yhi], [-np.pi + 8 * step, -np.pi + 24 * step, np.pi - 56 * step,
                                               np.pi - 40 * step], rtol=0, atol=1e-12)
     assert len(ex.stack) == 2 and ex.scene.integrator.precision == "f32"
+    said_s = ex.player.key("s")  # a zoom is another scene: saved where `render` would write it
+    assert said_s.startswith(f"saved {tmp_path / 'fractal_flip__'}") and "fractal_flip_frame_" in said_s, said_s
     ex.key("b")
+    assert ex.player.key("s").startswith(f"saved {tmp_path / 'fractal_flip' / 'fractal_flip_frame_'}")
     assert len(ex.stack) == 1 and grid.axes_of(ex.scene.map) == grid.axes_of(scene.map)
     ex.key("b")
     assert said[-1] == "at the preset's own axes"

@@ -50,6 +50,20 @@ def test_bad_preset_is_still_bad_input():
     assert r.returncode == 2 and len(r.stderr.splitlines()) == 1 and "no_such_preset" in r.stderr
 
 
+def test_a_scene_render_refuses_for_its_memory_is_refused_by_show_too(tmp_path):
+    """Before the display is looked at: a comparison records its variants whole before the window opens."""
+    r = run_cli("show", "compare_precision", "--set", "pendulums.count=1000000", "--out", tmp_path / "out",
+                env=env_without_display(), timeout=60)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1 and "GB of memory" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_suggested_render_keeps_arch_and_budget():
+    r = run_cli("show", "classic", "--arch", "cuda", "--budget", "2h", env=env_without_display(), timeout=60)
+    assert r.returncode == 2 and r.stderr.rstrip().endswith("pendulum render classic --arch cuda --budget 7200"), \
+        r.stderr
+
+
 def test_help_lists_the_keys():
     r = run_cli("show", "--help", timeout=60)
     assert r.returncode == 0
@@ -83,7 +97,7 @@ class Clock:
 
 def make_player(tmp_path, frames=5, fps=10):
     clock = Clock()
-    return Player(FakeSource(frames), fps, tmp_path, clock=clock), clock
+    return Player(FakeSource(frames), fps, lambda: tmp_path / "fake", clock=clock), clock
 
 
 def test_player_plays_at_fps_and_holds_the_last_frame(tmp_path):
@@ -98,6 +112,22 @@ def test_player_plays_at_fps_and_holds_the_last_frame(tmp_path):
     assert p.tick(clock.t + 0.1) and p.index == 3
     assert p.tick(clock.t + 0.2) and p.index == 4
     assert not p.tick(clock.t + 5) and p.index == 4 and p.at_end  # holds the last frame
+
+
+def test_s_saves_where_render_writes_and_never_through_a_symlink_made_since(tmp_path):
+    """A comparison's frames go to OUT/compare/NAME/, where `render` writes it, checked as render checks it at
+    each save: a symlink put there while the window is open (it could lead out of OUT) is refused."""
+    from render.commands.player import saves_to
+    from render.config.scene import load
+    p = Player(FakeSource(3), 10, saves_to(load("compare_precision"), tmp_path), clock=Clock())
+    folder = tmp_path / "compare" / "compare_precision"
+    assert p.key("s") == f"saved {folder / 'fake_frame_00000.png'}" and (folder / "fake_frame_00000.png").is_file()
+    shutil.rmtree(folder)
+    (tmp_path / "outside").mkdir()
+    folder.symlink_to(tmp_path / "outside")
+    said = p.key("s")
+    assert said.startswith("cannot save: ") and "symlink" in said, said
+    assert not any((tmp_path / "outside").iterdir())
 
 
 def test_player_keys(tmp_path):

@@ -22,6 +22,7 @@ import time
 
 import numpy as np
 
+from ..config.options import output_name
 from ..config.scene import from_dict
 from ..draw import axes
 from ..draw.canvas import Canvas
@@ -31,7 +32,7 @@ from ..maps import fractal
 from ..physics import grid
 from ..physics.stepper import Run
 from ..video import pipeline
-from .player import Player, say
+from .player import Player, saves_to, say
 from .window import Window
 
 BACK = ("b", "B", "BackSpace")
@@ -105,8 +106,9 @@ def value_text(canvas, kind: str, p: int, t: float) -> str:
 class Explorer:
     """The map on show, its zoom stack, the inset and the mouse; compose() makes the frame the window shows."""
 
-    def __init__(self, scene, arch: str, threads, save_dir, log=say):
-        self.arch, self.threads, self.save_dir, self.log = arch, threads, save_dir, log
+    def __init__(self, scene, arch: str, threads, out, log=say):
+        """out: the output root, where s saves a frame as `render` would write the map on show."""
+        self.arch, self.threads, self.out, self.log = arch, threads, out, log
         self.stack = [scene]  # the scenes zoomed into, as given (before validation promotes a zoom to f64)
         self.cursor = self.press = None
         self.changed = True
@@ -120,7 +122,9 @@ class Explorer:
         self.inset = None
         self.source = pipeline.Source(scene, arch=self.arch, threads=self.threads)
         self.scene, self.lay = self.source.scene, self.source.canvas.lay
-        self.player = Player(self.source, scene.video.fps, self.save_dir)
+        # a zoom is another scene: its frames go where `render` would write it, OUT/NAME__<its hash>/
+        named = scene if scene is self.stack[0] else output_name(scene, True)
+        self.player = Player(self.source, scene.video.fps, saves_to(named, self.out))
         self.size = self.lay.font or "6x13"  # the decorations' font; a map too small for them: the smaller one
         self.font = self.source.canvas.font or Font(self.size)
         self.axes, self.starts = grid.axes_of(self.scene.map), grid.starts(self.scene)
@@ -242,9 +246,9 @@ class Explorer:
         return out
 
 
-def explore(scene, arch: str, threads, save_dir, suggest: str, log=say, on_open=None) -> int:
+def explore(scene, arch: str, threads, out, suggest: str, log=say, on_open=None) -> int:
     """Open the window on the map and run until q/Esc or the window closes; returns the exit code."""
-    ex = Explorer(scene, arch, threads, save_dir, log)
+    ex = Explorer(scene, arch, threads, out, log)
     win = Window(f"pendulum show: {scene.name}", ex.lay.width, ex.lay.height, suggest=suggest)
     if on_open:
         on_open()

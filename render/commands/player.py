@@ -7,10 +7,12 @@ import struct
 import time
 import zlib
 from pathlib import Path
-from typing import Protocol
+from typing import Callable, Protocol
 
 import numpy as np
 
+from ..config.options import check_out_folder
+from ..errors import SceneError
 from ..video.atomic import write_atomic
 
 POLL_S = 1 / 60  # longest wait between looks at the keyboard (keys are read when the window is updated)
@@ -46,8 +48,9 @@ class FrameSource(Protocol):
 class Player:
     """Which frame is up, paused or playing, and when the next frame is due. Times come from `clock`."""
 
-    def __init__(self, source: FrameSource, fps: float, save_dir: Path, clock=time.perf_counter):
-        self.source, self.save_dir, self.clock = source, Path(save_dir), clock
+    def __init__(self, source: FrameSource, fps: float, folder: Callable[[], Path], clock=time.perf_counter):
+        """folder(): where s saves a frame, asked at each save (saves_to())."""
+        self.source, self.folder, self.clock = source, folder, clock
         self.period = 1.0 / fps if fps > 0 else 0.0
         self.paused = False
         self.quit = False
@@ -116,14 +119,27 @@ class Player:
         return min(POLL_S, max(0.0, self.due - now))
 
     def save(self) -> str:
-        name = self.source.name
-        path = self.save_dir / name / f"{name}_frame_{self.index:05d}.png"
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
+            folder = self.folder()
+        except SceneError as e:
+            return f"cannot save: {e}"
+        path = folder / f"{self.source.name}_frame_{self.index:05d}.png"
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
             write_atomic(path, png_bytes(self.frame))
         except OSError as e:
             return f"cannot save {path}: {e.strerror or e}"
         return f"saved {path}"
+
+
+def saves_to(scene, out: Path) -> Callable[[], Path]:
+    """Where s saves `scene`'s frames: where `render` writes it (OUT/NAME/, OUT/NAME__<hash>/ with overrides, a
+    comparison's OUT/compare/NAME/), checked as render checks it, again at each save: a symlink put there
+    while the window was open could lead out of OUT."""
+    def folder() -> Path:
+        check_out_folder(scene, out, files=())
+        return scene.out_dir(out)
+    return folder
 
 
 def png_bytes(frame: np.ndarray) -> bytes:

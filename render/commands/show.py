@@ -27,15 +27,18 @@ import time
 from pathlib import Path
 
 from ..video import pipeline
-from ..config.options import add_common, add_quality, check_out_folder, out_path, output_name, thread_count
+from ..config import budget
+from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, out_path, output_name,
+                              thread_count)
 from ..config.scene import load
-from .player import KEYS_HELP, FrameSource, Player, png_bytes, say  # noqa: F401 - png_bytes: show's PNG, for tests
+from .player import KEYS_HELP, FrameSource, Player, png_bytes, saves_to, say  # noqa: F401 - png_bytes: for tests
 from .window import DISPLAY_TIMEOUT_S, Window, check_display  # noqa: F401 - the display timeout is show's to tell
 
 
-def play(source: FrameSource, fps: float, save_dir: Path, suggest: str, log=say, on_open=None) -> int:
-    """Open the window and run until q/Esc or the window closes; returns the exit code."""
-    player = Player(source, fps, save_dir)
+def play(source: FrameSource, fps: float, folder, suggest: str, log=say, on_open=None) -> int:
+    """Open the window and run until q/Esc or the window closes; returns the exit code. folder(): where s
+    saves (player.saves_to)."""
+    player = Player(source, fps, folder)
     win = Window(f"pendulum show: {source.name}", *player.frame.shape[1::-1], suggest=suggest)
     if on_open:
         on_open()
@@ -71,7 +74,9 @@ def add_parser(sub):
                "  space     pause / play (at the end: play again from the start)\n"
                "  →         one frame more, and pause\n"
                "  r         restart from t = 0\n"
-               "  s         save the frame on screen to OUT/NAME/NAME_frame_<index>.png\n"
+               "  s         save the frame (without the inset and captions) where `pendulum render` writes\n"
+               "            this scene: OUT/NAME/NAME_frame_<index>.png (OUT/NAME__<hash>/ with --set,\n"
+               "            --quality or after a zoom; OUT/compare/NAME/ for a comparison)\n"
                "  q, Esc    quit (so does closing the window)\n"
                "At the end of the video the last frame stays up.\n"
                "A map (a preset with `fractal`) is explored with the mouse:\n"
@@ -83,6 +88,7 @@ def add_parser(sub):
     add_common(s)
     s.add_argument("--out", type=out_path, default=Path("out"), help="where s saves frames (default: out)")
     add_quality(s)
+    add_budget(s)
     s.add_argument("--threads", type=thread_count, default=None, help="CPU threads for Taichi (default: all cores)")
     s.set_defaults(func=run)
 
@@ -94,6 +100,10 @@ def render_command(args) -> str:
         parts += ["--set", o]
     if args.quality:
         parts += ["--quality", args.quality]
+    if args.arch != "cpu":
+        parts += ["--arch", args.arch]
+    if getattr(args, "budget", None) is not None:
+        parts += ["--budget", f"{args.budget:g}"]
     if args.out != Path("out"):
         parts += ["--out", str(args.out)]
     return shlex.join(parts)
@@ -103,7 +113,11 @@ def run(args) -> int:
     # frames saved with s go where `render` would write this scene: OUT/NAME__<hash>/ when overridden, and
     # never through a symlink or into a file (checked before the window opens, as render checks)
     scene = output_name(load(args.preset, args.overrides, args.quality), bool(args.overrides or args.quality))
+    scene = budgeted(scene, args)
     check_out_folder(scene, args.out, files=())
+    # what `render` refuses, `show` refuses too: it simulates and certifies the same (a comparison records its
+    # variants whole before the window opens), so memory and time are those of a render
+    budget.check_run([scene], args.out)
     suggest = render_command(args)
     probe = check_display(suggest)  # before any compiling: a missing display fails at once
     try:
@@ -111,6 +125,6 @@ def run(args) -> int:
             from .explore import explore
             return explore(scene, args.arch, args.threads, args.out, suggest, on_open=probe.close)
         source = pipeline.open_source(scene, arch=args.arch, threads=args.threads)  # a comparison: split screen
-        return play(source, scene.video.fps, args.out, suggest, on_open=probe.close)
+        return play(source, scene.video.fps, saves_to(scene, args.out), suggest, on_open=probe.close)
     finally:
         probe.close()
