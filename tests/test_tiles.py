@@ -204,6 +204,16 @@ def test_an_unreachable_scheduler_writes_nothing(tmp_path, monkeypatch):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_scheduler_without_workers_is_one_line_not_a_silent_wait(tmp_path, monkeypatch):
+    monkeypatch.setattr(tiled, "WORKERS_TIMEOUT_S", 2.0)
+    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as empty:
+        t = time.perf_counter()
+        code, err = cli("render", "fractal_flip", *(a for s in SETS for a in ("--set", s)), "--out",
+                        tmp_path / "out", "--scheduler", empty.scheduler_address, "--no-progress")
+    assert code == 1 and err.count("\n") == 1 and "has no worker (waited 2 s)" in err, err
+    assert time.perf_counter() - t < 30 and not (tmp_path / "out").exists()
+
+
 def test_assembly_undoes_the_deltas():
     """The bands' frames travel as XOR deltas, zlib-compressed: they come back exactly."""
     sc = scene()

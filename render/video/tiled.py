@@ -25,6 +25,7 @@ from ..errors import BatchError, SceneError, SimulationError
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
 ENV = "DASK_SCHEDULER_ADDRESS"  # the cluster `batch` and a map's `render` use without --scheduler
 CONNECT_TIMEOUT = "10s"  # how long Client keeps trying a scheduler (it retries a refused connection till then)
+WORKERS_TIMEOUT_S = 30.0  # how long a reached scheduler may be without a worker (one may be starting)
 
 
 def scheduler_address(text: str | None, what: str = "--scheduler") -> str | None:
@@ -49,12 +50,38 @@ def env_address() -> str | None:
 
 
 def connect(address: str):
-    """A Client of the Dask scheduler at `address`; BatchError (exit 1) when it cannot be reached."""
+    """A Client of the Dask scheduler at `address`, which has a worker; BatchError (exit 1) when it cannot be
+    reached or has had no worker for WORKERS_TIMEOUT_S (its tiles would wait for one forever, saying nothing)."""
     from dask.distributed import Client
     try:
-        return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+        client = Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except Exception as e:  # noqa: BLE001 - whatever Dask raises here (OSError, TimeoutError, ...)
         raise BatchError(f"cannot reach the Dask scheduler at {address}: {e}") from None
+    try:
+        client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
+    except Exception:  # noqa: BLE001 - TimeoutError, or the scheduler gone meanwhile
+        client.close()
+        raise BatchError(f"the Dask scheduler at {address} has no worker (waited {WORKERS_TIMEOUT_S:g} s); start "
+                         f"one with `dask worker {address}`") from None
+    return client
+
+
+@contextmanager
+def quiet():
+    """distributed's loggers and warnings held back while a cluster works for this process: a lost scheduler
+    is reported as one line by collect(), not after 25 lines of its client's traceback, and a LocalCluster's
+    scheduler starts an HTTP server on 8787 even without a dashboard, and warns where that port is taken."""
+    import logging
+    import warnings
+    log = logging.getLogger("distributed")
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=r"Port \d+ is already in use", category=UserWarning)
+            yield
+    finally:
+        log.setLevel(level)
 
 
 def check(scene, how: str):
@@ -76,14 +103,20 @@ def cluster(address: str | None, workers: int | None):
     if address:
         client = connect(address)
         try:
-            yield client
+            with quiet():
+                yield client
         finally:
             client.close()
         return
     import logging
+    import tempfile
+    import dask
     from dask.distributed import Client, LocalCluster
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None, silence_logs=logging.ERROR) as local, \
+    # its scratch space (lock files) in a folder removed after, not left in $TMPDIR/dask-scratch-space
+    with tempfile.TemporaryDirectory(prefix="pendulum-dask-") as scratch, quiet(), \
+            dask.config.set({"temporary-directory": scratch}), \
+            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                         dashboard_address=None, silence_logs=logging.ERROR) as local, \
             Client(local, set_as_default=False) as client:
         yield client
 
