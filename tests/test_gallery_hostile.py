@@ -344,3 +344,18 @@ def test_any_json_gives_a_card_or_says_why_not(tmp_path, meta):
     [found] = gallery.find_renders(tmp_path)
     html = gallery.card(found, Path("r"))
     assert ("skipped: " in html) == bool(found.skipped) and (found.meta is None) == bool(found.skipped)
+
+
+def test_a_folder_where_a_poster_goes_leaves_that_card_without_a_poster_not_the_page_unwritten(tmp_path):
+    out = tmp_path / "out"
+    r = run_cli("render", "classic", "--set", "video.width=64", "--set", "video.height=36", "--set",
+                "video.duration=0.5", "--set", 'video.formats=["mp4"]', "--out", out, "--no-progress")
+    assert r.returncode == 0, r.stderr
+    [folder] = out.iterdir()
+    blocker = folder / f"{folder.name}.poster.jpg"
+    blocker.mkdir()
+    os.utime(blocker, (0, 0))  # older than the video: a poster "to make again"
+    r = run_cli("gallery", "--out", out)
+    assert r.returncode == 0 and r.stdout.startswith("1 render(s) ->"), r.stderr
+    page = (out / "index.html").read_text()
+    assert f'src="{folder.name}/{folder.name}.mp4"' in page and "poster=" not in page and blocker.is_dir()

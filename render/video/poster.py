@@ -35,6 +35,8 @@ def ensure(video: Path, at_s: float) -> Path | None:
     try:
         if _regular_mtime(path) >= os.lstat(video).st_mtime:
             return path
+        if path.is_dir() and not path.is_symlink():  # nothing to replace it with: the page goes on without
+            return None
         with replacing(path, suffix=".jpg") as tmp:
             cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-nostdin", "-y", "-ss", f"{max(at_s, 0):.3f}",
                    "-f", "mov", "-i", f"file:{os.path.abspath(video)}", "-frames:v", "1",
