@@ -89,6 +89,16 @@ def test_the_explorer_without_a_window(tmp_path):
     assert said[-1] == "at the preset's own axes"
 
 
+def test_a_map_too_small_for_an_inset_says_so_on_a_click(tmp_path):
+    said = []
+    scene = load("fractal_flip", ["video.width=40", "video.height=16", "video.fps=10", "video.duration=1"])
+    ex = Explorer(scene, "cpu", None, tmp_path, log=said.append)
+    ex.mouse("press", (5, 5))
+    ex.mouse("release", (5, 5))
+    assert ex.inset is None and said[-1] == "inset: a 40x16 map has no room for one", said
+    assert ex.compose().shape == (16, 40, 3)
+
+
 def test_click_opens_the_pixels_pendulum_and_a_box_zooms(xvfb, tmp_path):  # noqa: F811 - the fixture
     lay = grid.layout(W, H)
     assert lay.font is not None

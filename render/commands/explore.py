@@ -167,7 +167,10 @@ class Explorer:
 
     def click(self, c: int, r: int):
         start = self.start_of(c, r)
-        size = max(16, min(self.lay.height // 2, self.lay.width // 3, 360)) // 2 * 2
+        room = min(self.lay.width, self.lay.height) - 2 * max(self.lay.pad, 3) - 2  # inside compose()'s margins
+        size = min(max(16, min(self.lay.height // 2, self.lay.width // 3, 360)), room) // 2 * 2
+        if size < 16:  # the smallest canvas a pendulum is drawn on
+            return self.log(f"inset: a {self.lay.width}x{self.lay.height} map has no room for one")
         self.inset = Inset(self.scene, start, size, self.arch, self.threads)
         self.inset_value = value_text(self.source.canvas, self.scene.fractal, r * self.lay.w + c, self.source.sim.t)
         self.log("inset: " + " ".join(f"{k}={v!r}" for k, v in self.inset.start.items())
