@@ -77,13 +77,16 @@ def test_pairs_vanish_within_the_reported_error_and_the_error_is_honest(classic_
     assert row["errors"][0] < 0.3 * row["exponents"][0]
 
 
-def variational_lambda1(scene, i: int, t: np.ndarray) -> np.ndarray:
-    """λ1(t) of pendulum i from the canonical axis δq1, by DOP853 on the variational equations of
-    reference.py's model (its Jacobian by central differences of its force), the tangent vector carried
-    into (q, v) and back into canonical (q, p): p = M(θ)ω for a chain, m·v for springs."""
+def variational_spectrum(scene, i: int, t: np.ndarray) -> np.ndarray:
+    """Benettin's running spectrum (F, 2d) of pendulum i at the frame times t, from the canonical axes, as
+    the package measures it but from independent parts: the 2d tangent vectors ride along by DOP853 on the
+    variational equations of reference.py's model (its Jacobian by central differences of its force) in
+    (q, v); at each frame they are taken into canonical (q, p), p = M(θ)ω for a chain and m·v for springs,
+    re-orthonormalised by QR (ln |R_ii| summed), and taken back."""
     p = reference.params(scene)
-    q0, v0 = (a[i] for a in reference.initial_state(scene))
-    d, eps = len(q0), 1e-6
+    q, v = (a[i] for a in reference.initial_state(scene))
+    d, eps = len(q), 1e-6
+    steps = eps * np.eye(2 * d)
 
     def accel(q, v):  # rows of states (N, d) -> (N, d)
         return reference.accel(p, q, v)
@@ -93,28 +96,35 @@ def variational_lambda1(scene, i: int, t: np.ndarray) -> np.ndarray:
             return np.einsum("nij,nj->ni", reference.chain_mass(q, p), v)
         return np.repeat(p.masses, 2) * v
 
-    steps = eps * np.eye(2 * d)
-
     def jac(f, q, v):  # d f / d(q, v) at one state, (d, 2d), by central differences in one batched call
         plus = f(q + steps[:, :d], v + steps[:, d:])
         minus = f(q - steps[:, :d], v - steps[:, d:])
         return ((plus - minus) / (2 * eps)).T
 
-    def rhs(_, y):
-        q, v, dq, dv = y[:d], y[d:2 * d], y[2 * d:3 * d], y[3 * d:]
-        return np.concatenate([v, accel(q[None], v[None])[0], dv, jac(accel, q, v) @ np.concatenate([dq, dv])])
+    def rhs(_, y):  # the state and the tangent vectors (columns of a 2d x 2d matrix, in (δq, δv))
+        q, v, tangents = y[:d], y[d:2 * d], y[2 * d:].reshape(2 * d, 2 * d)
+        flow = np.block([[np.zeros((d, d)), np.eye(d)], [jac(accel, q, v)]])
+        return np.concatenate([v, accel(q[None], v[None])[0], (flow @ tangents).ravel()])
 
-    jp = jac(momenta, q0, v0)  # δp = jp @ (δq, δv); solve for δv given δq = e1, δp = 0
-    dq0 = np.eye(d)[0]
-    dv0 = np.linalg.solve(jp[:, d:], -jp[:, :d] @ dq0)
-    sol = solve_ivp(rhs, (0, t[-1]), np.concatenate([q0, v0, dq0, dv0]), method="DOP853", t_eval=t,
-                    rtol=1e-11, atol=1e-11)
-    assert sol.success
-    out = []
-    for y in sol.y.T:
-        q, v, dq, dv = y[:d], y[d:2 * d], y[2 * d:3 * d], y[3 * d:]
-        out.append(np.log(np.linalg.norm(np.concatenate([dq, jac(momenta, q, v) @ np.concatenate([dq, dv])]))))
-    return np.array(out) / t
+    def canonical(q, v, tangents):  # (δq, δv) -> (δq, δp)
+        return np.vstack([tangents[:d], jac(momenta, q, v) @ tangents])
+
+    def velocities(q, v, basis):  # (δq, δp) -> (δq, δv)
+        jp = jac(momenta, q, v)
+        return np.vstack([basis[:d], np.linalg.solve(jp[:, d:], basis[d:] - jp[:, :d] @ basis[:d])])
+
+    tangents, sums, out, t0 = velocities(q, v, np.eye(2 * d)), np.zeros(2 * d), [], 0.0
+    for tf in t:
+        sol = solve_ivp(rhs, (t0, tf), np.concatenate([q, v, tangents.ravel()]), method="DOP853",
+                        rtol=1e-11, atol=1e-11)
+        assert sol.success
+        y = sol.y[:, -1]
+        q, v = y[:d], y[d:2 * d]
+        basis, r = np.linalg.qr(canonical(q, v, y[2 * d:].reshape(2 * d, 2 * d)))
+        sums += np.log(np.abs(np.diagonal(r)))
+        out.append(sums / tf)
+        tangents, t0 = velocities(q, v, basis), tf
+    return np.array(out)
 
 
 CASES = {"classic": ("classic", [], 0), "triple_classic": ("triple_classic", ["video.duration=3"], 0),
@@ -122,22 +132,24 @@ CASES = {"classic": ("classic", [], 0), "triple_classic": ("triple_classic", ["v
 
 
 @pytest.mark.parametrize("case", CASES)
-def test_lambda1_agrees_with_an_independent_variational_reference(case):
-    """Inside the certificate's faithful window, from the same initial tangent vector, λ1(t) of the package
-    (tangent map of its integrator, by forward-mode AD) matches DOP853 on independent variational equations
-    within 0.1 % (the brief asks 2 %) at every frame past the first second."""
+def test_the_spectrum_agrees_with_an_independent_variational_reference(case):
+    """Inside the certificate's faithful window, from the same initial tangent vectors, every running exponent
+    of the package (tangent map of its integrator, by forward-mode AD) matches Benettin's on DOP853 and
+    independent variational equations within 0.1 % of λ1 (the brief asks 2 %) at every frame past the first
+    second: not λ1 alone, so two exponents swapped, or one lost, cannot pass on the sum and pairs."""
     preset, sets, i = CASES[case]
     scene = load(preset, ["video.duration=5", *sets])
     cert = certify.certify(scene.replace(integrator={"min_faithful": 0.0}), indices=np.array([i]))
     assert cert.until_s[0] >= scene.video.duration  # the whole run is faithful
     run = lyapunov.spectrum(scene, np.array([i]))
     t = run["t"]
-    ours = run["running"][:, 0, 0]  # the first column: the growth of the first initial vector, δq1
-    ref = variational_lambda1(scene, i, t)
+    ours = run["running"][:, 0]  # (frames, 2D): each column the growth its QR step gives, as the reference's
+    ref = variational_spectrum(scene, i, t)
     late = t >= 1.0
-    # The brief asks for 2 %; measured: 3e-9 (classic), 1.5e-8 (triple), 1.1e-5 (elastic_fan with rk4; with
-    # its preset's verlet at dt "auto" the numerical flow's own λ1 is 1.3 % off the exact flow's).
-    assert np.abs(ours[late] - ref[late]).max() <= 1e-3 * np.abs(ref[-1]), (ours[-1], ref[-1])
+    # The brief asks for 2 %; measured, the largest difference in any column over λ1: 4.5e-9 (classic), 4.2e-8
+    # (triple), 7.9e-5 (elastic_fan with rk4; with its preset's verlet at dt "auto" the numerical flow's own λ1
+    # is 1.3 % off the exact flow's).
+    assert np.abs(ours[late] - ref[late]).max() <= 1e-3 * np.abs(ref[-1, 0]), (ours[-1], ref[-1])
     row = lyapunov.summary(run, 0.0)[0]  # the whole spectrum of every system: 2D exponents summing to 0
     assert len(row["exponents"]) == {"rigid": 4, "triple": 6, "elastic": 8}[scene.system]
     assert abs(row["checks"]["sum"]) < 1e-3 * row["exponents"][0]
