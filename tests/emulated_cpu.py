@@ -76,6 +76,8 @@ def main(argv=None) -> int:
     ap.add_argument("presets", nargs="*", metavar="PRESET", help="default: every preset in presets/")
     ap.add_argument("--cpu", default="Haswell", help="QEMU's CPU model (`qemu-x86_64 -cpu help`; default Haswell)")
     ap.add_argument("--sincos", action="store_true", help="also run tests/test_sincos.py emulated")
+    ap.add_argument("--bits", action="store_true", help="also run tests/test_state_bits.py emulated: the "
+                                                        "simulated states' digests")
     ap.add_argument("--keep", action="store_true", help="keep out/emulated-CPU/ (renders, frames, kernel cache)")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)  # PRESET NPZ OUT, in the emulated process
     args = ap.parse_args(argv)
@@ -103,11 +105,13 @@ def main(argv=None) -> int:
     emulated = [qemu, "-cpu", args.cpu, sys.executable]
     failed = 0
     try:
-        if args.sincos:
-            res = subprocess.run([*emulated, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/test_sincos.py"],
+        for wanted, tests in ((args.sincos, "tests/test_sincos.py"), (args.bits, "tests/test_state_bits.py")):
+            if not wanted:
+                continue
+            res = subprocess.run([*emulated, "-m", "pytest", "-q", "-p", "no:cacheprovider", tests],
                                  cwd=ROOT, env=env, capture_output=True, text=True)
             tail = res.stdout.strip().splitlines()[-1:] or ["(no output)"]
-            print(f"tests/test_sincos.py on {args.cpu}: {tail[0]}", flush=True)
+            print(f"{tests} on {args.cpu}: {tail[0]}", flush=True)
             failed += res.returncode != 0
         for name in names:
             npz = work / f"{name}.npz"

@@ -130,3 +130,5 @@ def test_cuda_request_falls_back_to_cpu_with_one_warning(tmp_path):
     meta = json.loads((out_folder(tmp_path, "classic") / "metadata.json").read_text())
     if meta["arch"] == "cpu":  # no GPU here (CI): exactly one clear warning
         assert r.stderr.count("warning: --arch cuda") == 1
+    else:  # a GPU: the render ran there, with nothing to warn of
+        assert meta["arch"] == "cuda" and "warning" not in r.stderr, (meta["arch"], r.stderr)
