@@ -39,10 +39,11 @@ test: $(BIN)/pendulum
 goldens: $(BIN)/pendulum
 	$(BIN)/python -m pytest tests/test_golden.py tests/test_font.py --update-goldens -q
 
-# The golden frames and tests/test_sincos.py on an AVX2 CPU emulated by QEMU (apt-get install -y qemu-user), for
-# a machine with AVX-512: slow, and not part of `make test` (docs/testing.md).
+# The golden frames, tests/test_sincos.py and the state digests of tests/test_state_bits.py on an AVX2 CPU
+# emulated by QEMU (apt-get install -y qemu-user), for a machine with AVX-512: slow, and not part of `make test`
+# (docs/testing.md).
 check-avx2: $(BIN)/pendulum
-	$(BIN)/python tests/emulated_cpu.py --sincos
+	$(BIN)/python tests/emulated_cpu.py --sincos --bits
 
 presets: $(BIN)/pendulum
 	$(BIN)/pendulum presets

@@ -1,6 +1,7 @@
-"""The golden frames, and optionally the sin/cos tests, on the other CPU kind: AVX2, emulated on an AVX-512 machine.
+"""The golden frames, and optionally the sin/cos tests and the state digests, on the other CPU kind: AVX2, emulated
+on an AVX-512 machine.
 
-    .venv/bin/python tests/emulated_cpu.py [--cpu Haswell] [--sincos] [--keep] [PRESET ...]
+    .venv/bin/python tests/emulated_cpu.py [--cpu Haswell] [--sincos] [--bits] [--keep] [PRESET ...]
 
 The suite must hold on AVX2 and on AVX-512 (docs/numerics.md), but `make test` checks only the machine's own
 kind. QEMU's user-mode emulator (Debian: `apt-get install -y qemu-user`; QEMU 7.2 emulates AVX2 and FMA but no
