@@ -89,6 +89,26 @@ def test_the_explorer_without_a_window(tmp_path):
     assert said[-1] == "at the preset's own axes"
 
 
+def test_a_second_click_plays_its_pixel_in_the_same_inset_as_a_new_one_would(tmp_path):
+    """A click on another pixel of the map moves the inset to that start: no new Run or Canvas (Taichi never
+    frees their fields and kernels), and the same frames and start as an inset made for that pixel."""
+    from render.commands.explore import Inset
+    scene = load("fractal_flip", ["video.width=64", "video.height=64", "video.fps=10", "video.duration=1"])
+    ex = Explorer(scene, "cpu", None, tmp_path, log=[].append)
+    ex.click(41, 9)
+    first = ex.inset
+    for _ in range(3):
+        first.advance(0.0)
+    ex.click(12, 50)
+    assert ex.inset is first
+    fresh = Inset(ex.scene, ex.start_of(12, 50), first.size, "cpu", None)
+    assert ex.inset.start == fresh.start and np.array_equal(ex.inset.frame, fresh.frame)
+    for _ in range(3):
+        ex.inset.advance(0.0)
+        fresh.advance(0.0)
+        assert np.array_equal(ex.inset.frame, fresh.frame)
+
+
 def test_a_map_too_small_for_an_inset_says_so_on_a_click(tmp_path):
     said = []
     scene = load("fractal_flip", ["video.width=40", "video.height=16", "video.fps=10", "video.duration=1"])

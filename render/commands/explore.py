@@ -29,7 +29,7 @@ from ..draw.canvas import Canvas
 from ..draw.font import Font
 from ..errors import SceneError, SimulationError
 from ..maps import fractal
-from ..physics import grid
+from ..physics import grid, registry
 from ..physics.stepper import Run
 from ..video import pipeline
 from .player import Player, saves_to, say
@@ -58,16 +58,33 @@ class Inset:
     """A pixel's pendulum, played in a corner of the map at its fps, from the start again at the end."""
 
     def __init__(self, scene, start: dict, size: int, arch: str, threads):
+        self.map, self.size = scene, size
         self.scene = pixel_scene(scene, start, size)
         self.run = Run(self.scene, arch, threads, precision=scene.integrator.precision, keep_log=True)
         self.canvas = Canvas(self.scene, self.run.sim)
         self.period = 1.0 / self.scene.video.fps
-        q, v = self.run.sim.q.to_numpy()[0], self.run.sim.v.to_numpy()[0]
-        self.start = {k: float((q if k.startswith("theta") else v)[int(k[5:]) - 1]) for k in start}  # as it runs
+        self.begin(start, self.run.sim.q.to_numpy(), self.run.sim.v.to_numpy())
+
+    def takes(self, scene, start: dict, size: int) -> bool:
+        """Whether this inset can play another pixel of `scene`'s map: one whose axes are angles and rates only
+        changes the start, which its kernels do not hold (a length or mass axis is compiled into them). Taichi
+        never frees a Run's fields and kernels: a new inset a click took 4.6 MB and 3.4 s."""
+        return scene is self.map and size == self.size and all(k[:5] in ("theta", "omega") for k in start)
+
+    def move(self, start: dict):
+        """Play the pendulum that starts at `start` instead, from its first frame."""
+        pixel = pixel_scene(self.map, start, self.size)
+        q0, v0 = registry.get(pixel.system)(pixel).initial_state()  # its plan: no Taichi field
+        self.begin(start, q0, v0)
+
+    def begin(self, start: dict, q0, v0):
+        self.state = (q0, v0)
+        q, v = (a.astype(self.run.sim.q.to_numpy().dtype)[0] for a in (q0, v0))  # as it runs
+        self.start = {k: float((q if k.startswith("theta") else v)[int(k[5:]) - 1]) for k in start}
         self.restart(time.perf_counter())
 
     def restart(self, now: float):
-        self.run.sim.restart()
+        self.run.sim.load(*self.state)
         self.canvas.restart()
         self.steps = self.run.frames()
         self.advance(now)
@@ -119,7 +136,7 @@ class Explorer:
         return self.player.quit
 
     def open(self, scene):
-        self.inset = None
+        self.inset = self.spare = None  # the inset on show, and the one kept for the next click on this map
         self.source = pipeline.Source(scene, arch=self.arch, threads=self.threads)
         self.scene, self.lay = self.source.scene, self.source.canvas.lay
         # a zoom is another scene: its frames go where `render` would write it, OUT/NAME__<its hash>/
@@ -171,7 +188,11 @@ class Explorer:
         size = min(max(16, min(self.lay.height // 2, self.lay.width // 3, 360)), room) // 2 * 2
         if size < 16:  # the smallest canvas a pendulum is drawn on
             return self.log(f"inset: a {self.lay.width}x{self.lay.height} map has no room for one")
-        self.inset = Inset(self.scene, start, size, self.arch, self.threads)
+        if self.spare is not None and self.spare.takes(self.scene, start, size):
+            self.spare.move(start)
+        else:
+            self.spare = Inset(self.scene, start, size, self.arch, self.threads)
+        self.inset = self.spare
         self.inset_value = value_text(self.source.canvas, self.scene.fractal, r * self.lay.w + c, self.source.sim.t)
         self.log("inset: " + " ".join(f"{k}={v!r}" for k, v in self.inset.start.items())
                  + f" pixel ({c}, {r}): {self.inset_value}")
