@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 export TI_SKIP_VERSION_CHECK := ON
+# a bare `make` renders the demo, not only the venv (the first rule)
+.DEFAULT_GOAL := demo
 
 .PHONY: demo test goldens check-avx2 presets accuracy bench batch figures clean
 

@@ -203,7 +203,7 @@ def test_an_unreachable_scheduler_writes_nothing(tmp_path, monkeypatch):
 
 def test_a_scheduler_without_workers_is_one_line_not_a_silent_wait(tmp_path, monkeypatch):
     monkeypatch.setattr(tiled, "WORKERS_TIMEOUT_S", 2.0)
-    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as empty:
+    with tiled.quiet(), distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as empty:
         t = time.perf_counter()
         code, err = cli("render", "fractal_flip", *(a for s in SETS for a in ("--set", s)), "--out",
                         tmp_path / "out", "--scheduler", empty.scheduler_address, "--no-progress")

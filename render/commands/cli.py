@@ -159,12 +159,14 @@ def cmd_simulate(args) -> int:
 def cmd_presets(args) -> int:
     from ..config.scene import list_presets, load
 
-    for path in list_presets():
+    paths = list_presets()
+    width = max((len(p.stem) for p in paths), default=0)  # the names' column as wide as the longest
+    for path in paths:
         try:
             s = load(str(path))
-            print(f"{s.name:16s} {s.system:8s} N={s.pendulums.count:<8d} {s.description}")
+            print(f"{s.name:{width}s} {s.system:8s} N={s.pendulums.count:<8d} {s.description}")
         except SceneError as e:
-            print(f"{path.stem:16s} INVALID  {e}")
+            print(f"{path.stem:{width}s} INVALID  {e}")
     return 0
 
 
