@@ -10,19 +10,22 @@ export TI_SKIP_VERSION_CHECK := ON
 
 $(BIN)/pendulum: pyproject.toml
 	@# Taichi 1.7.4 has wheels for Python 3.9-3.13, this package needs 3.11: say so before a venv is made, and
-	@# make it afresh where an earlier try left one of an older Python (venv would keep that Python)
-	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || { echo "make: $(PYTHON) is older \
-	than Python 3.11, which this needs: make $(or $(MAKECMDGOALS),demo) PYTHON=python3.11 (3.11 to 3.13)" >&2; exit 2; }
-	$(BIN)/python -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null || $(PYTHON) -m venv --clear $(VENV)
+	@# make it afresh where an earlier try left one of another Python (venv would keep that Python)
+	@$(PYTHON) -c 'import sys; sys.exit(not (3, 11) <= sys.version_info[:2] <= (3, 13))' || { echo "make: \
+	$(PYTHON) is missing or not Python 3.11 to 3.13, which this needs (Taichi 1.7.4's wheels): make \
+	$(or $(MAKECMDGOALS),demo) PYTHON=python3.11" >&2; exit 2; }
+	$(BIN)/python -c 'import sys; sys.exit(not (3, 11) <= sys.version_info[:2] <= (3, 13))' 2>/dev/null \
+	|| $(PYTHON) -m venv --clear $(VENV)
 	@# uv (from PyPI) installs the same packages as pip from the same index in a fraction of the time: 39 s
 	@# against 3 min 36 s for this venv on a loaded 2-core machine, most of make test's set-up in CI
-	$(BIN)/python -m pip install --quiet uv
+	$(BIN)/python -m pip install --quiet uv || echo "make: no uv; pip installs instead (slower)" >&2
 	@# the distribution was called "pendulum" before; a venv holding both would have two owners of render/
 	$(BIN)/python -m pip uninstall --quiet --yes pendulum 2>/dev/null || true
 	@# --compile-bytecode: pip writes each package's .pyc files as it installs, uv does not, and where
 	@# PYTHONDONTWRITEBYTECODE is set (as on these machines) Python then compiles taichi, numpy, scipy... from
 	@# source in every process: 1.9 s of each import (3.4 s -> 1.4 s, median of 5), 1 s of a short render
-	@# uv reads no pip.conf: where it fails (an index or proxy only pip is configured for), pip installs instead
+	@# uv reads no pip.conf: where it fails or is missing (an index or proxy only pip is configured for), pip
+	@# installs instead
 	$(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[test]' \
 	|| $(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $@

@@ -18,6 +18,7 @@ import pytest
 
 from conftest import ROOT
 from render.commands.explore import Explorer
+from render.config.options import output_name
 from render.config.scene import load
 from render.draw import axes
 from render.physics import grid
@@ -80,8 +81,11 @@ def test_the_explorer_without_a_window(tmp_path):
     assert np.allclose([xlo, xhi, ylo, yhi], [-np.pi + 8 * step, -np.pi + 24 * step, np.pi - 56 * step,
                                               np.pi - 40 * step], rtol=0, atol=1e-12)
     assert len(ex.stack) == 2 and ex.scene.integrator.precision == "f32"
-    said_s = ex.player.key("s")  # a zoom is another scene: saved where `render` would write it
-    assert said_s.startswith(f"saved {tmp_path / 'fractal_flip__'}") and "fractal_flip_frame_" in said_s, said_s
+    said_s = ex.player.key("s")  # a zoom is another scene: saved where `render` would write it, given its box
+    box = [f"map.{k}=[{lo!r}, {hi!r}]" for k in ("x_range", "y_range") for lo, hi in [getattr(ex.stack[-1].map, k)]]
+    zoomed = output_name(load("fractal_flip", ["video.width=64", "video.height=64", "video.fps=10",
+                                               "video.duration=1", *box]), True)
+    assert said_s.startswith(f"saved {tmp_path / zoomed.name / 'fractal_flip_frame_'}"), (said_s, zoomed.name)
     ex.key("b")
     assert ex.player.key("s").startswith(f"saved {tmp_path / 'fractal_flip' / 'fractal_flip_frame_'}")
     assert len(ex.stack) == 1 and grid.axes_of(ex.scene.map) == grid.axes_of(scene.map)

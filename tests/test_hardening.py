@@ -338,21 +338,27 @@ def test_an_unwritable_kernel_cache_is_replaced_with_one_warning_not_a_crash(tmp
     assert (tmp_path / "c.npz").exists() and any((tmp_path / "tmp").iterdir())
 
 
-def test_a_missing_dependency_is_one_line_naming_what_to_install_and_leaves_no_folder(tmp_path):
-    """matplotlib, imported only where a chart is drawn, hidden from the process as a partial install would
-    lack it: the spectrum is measured, then the chart fails, and the folder made for it goes again."""
+def hiding(tmp_path, module: str) -> dict:
+    """An environment in which `module` cannot be imported, as a partial install would lack it."""
     (tmp_path / "hide").mkdir()
     (tmp_path / "hide" / "sitecustomize.py").write_text(
         "import sys\n"
         "class Hide:\n"
         "    def find_spec(self, name, path=None, target=None):\n"
-        "        if name.partition('.')[0] == 'matplotlib':\n"
+        f"        if name.partition('.')[0] == {module!r}:\n"
         "            raise ModuleNotFoundError(f'No module named {name!r}', name=name)\n"
         "sys.meta_path.insert(0, Hide())\n")
-    env = {**os.environ, "PYTHONPATH": str(tmp_path / "hide")}
-    r = run_cli("lyapunov", "classic", "--set", "video.duration=3", "--set", "video.fps=10", "--out",
-                tmp_path / "out", "--no-progress", env=env)
+    return {**os.environ, "PYTHONPATH": str(tmp_path / "hide")}
+
+
+@pytest.mark.parametrize("module, argv, need", [
+    ("matplotlib", ["lyapunov", "classic", "--set", "video.duration=3", "--set", "video.fps=10"], "matplotlib"),
+    ("distributed", ["render", "fractal_flip", "--tiles", "2", *TINY], "dask[distributed]")])
+def test_a_missing_dependency_is_one_line_naming_what_to_install_and_leaves_no_folder(tmp_path, module, argv, need):
+    """matplotlib, imported only where a chart is drawn: the spectrum is measured, then the chart fails, and the
+    folders made for it go again. distributed, for tiles: dask raises an ImportError of its own about it."""
+    r = run_cli(*argv, "--out", tmp_path / "out", "--no-progress", env=hiding(tmp_path, module))
     assert r.returncode == 1 and r.stderr.splitlines() == [
-        "pendulum: failed: this needs the Python package matplotlib, which is not installed here: "
-        "pip install 'matplotlib'"], r.stderr
-    assert not any((tmp_path / "out").iterdir())
+        f"pendulum: failed: this needs the Python package {need}, which is not installed here: "
+        f"pip install '{need}'"], r.stderr
+    assert not (tmp_path / "out").exists()  # nor the folders made for it

@@ -25,7 +25,7 @@ from ..video.atomic import write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
                               out_path, positive_int, progress_wanted, thread_count, usable_cores)
-from ..video.tiled import connect, env_address, scheduler_address
+from ..video.tiled import close, connect, env_address, quiet, scheduler_address
 from ..video.version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
@@ -119,21 +119,22 @@ def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
 def run_dask(scenes, out_root, address, arch, threads, digest):
     """Yield result rows as Dask tasks finish; outputs are written by the workers into out_root."""
     from dask.distributed import as_completed
-    client = connect(address)
-    futs = {}
-    try:
-        for s in scenes:
-            fut = client.submit(render_one, s, str(out_root), arch, threads, digest, pure=False,
-                                key=f"pendulum-render-{s.name}-{os.urandom(4).hex()}")
-            futs[fut] = s
-        for fut in as_completed(list(futs), loop=client.loop):
-            try:
-                yield fut.result()
-            except Exception as e:  # noqa: BLE001 - e.g. KilledWorker
-                yield {"preset": futs[fut].name, "status": "failed", "error": f"{type(e).__name__}: {e}"}
-    finally:
-        client.cancel(list(futs))  # a no-op for finished tasks; stops queued ones when we are interrupted
-        client.close()
+    with quiet():  # a lost scheduler: its tasks' rows say so, not distributed's tracebacks
+        client = connect(address)
+        futs = {}
+        try:
+            for s in scenes:
+                fut = client.submit(render_one, s, str(out_root), arch, threads, digest, pure=False,
+                                    key=f"pendulum-render-{s.name}-{os.urandom(4).hex()}")
+                futs[fut] = s
+            for fut in as_completed(list(futs), loop=client.loop):
+                try:
+                    yield fut.result()
+                except Exception as e:  # noqa: BLE001 - e.g. KilledWorker
+                    yield {"preset": futs[fut].name, "status": "failed", "error": f"{type(e).__name__}: {e}"}
+        finally:
+            client.cancel(list(futs))  # a no-op for finished tasks; stops queued ones when we are interrupted
+            close(client)
 
 
 # ---------------------------------------------------------------- the command

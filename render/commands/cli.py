@@ -227,16 +227,25 @@ def main(argv=None) -> int:
         return fail(1, "failed", f"{e.strerror or e}{where}", debug)
     except MemoryError as e:
         return fail(1, "failed", f"out of memory ({e or 'MemoryError'})", debug)
-    except ModuleNotFoundError as e:  # a dependency missing where it is imported lazily (a partial install)
-        top = (e.name or "").partition(".")[0]
-        if not top or top == __package__.partition(".")[0]:  # one of ours missing is a bug: below
-            return fail(1, "unexpected error", f"{e} (run with --debug for the traceback)", debug)
-        need = DISTRIBUTIONS.get(top, top)
-        return fail(1, "failed", f"this needs the Python package {need}, which is not installed here: "
-                                 f"pip install '{need}'", debug)
     except Exception as e:  # noqa: BLE001 - a bug or an unforeseen fault: still one line, not a traceback
+        need = missing(e)
+        if need:
+            return fail(1, "failed", f"this needs the Python package {need}, which is not installed here: "
+                                     f"pip install '{need}'", debug)
         why = f"{type(e).__name__}: {e}".rstrip(": ")
         return fail(1, "unexpected error", f"{why} (run with --debug for the traceback)", debug)
+
+
+def missing(e: Exception) -> str | None:
+    """The distribution to install when `e` is a dependency missing where it is imported lazily (a partial
+    install: matplotlib for a chart, dask for tiles), else None; one of this package's own modules missing is a
+    bug. dask without distributed raises an ImportError of its own, whose cause names the module."""
+    for err in (e, e.__cause__):
+        name = getattr(err, "name", None) if isinstance(err, ModuleNotFoundError) else None
+        if name:
+            top = name.partition(".")[0]
+            return None if top == __package__.partition(".")[0] else DISTRIBUTIONS.get(top, top)
+    return None
 
 
 def fail(code: int, kind: str, error, debug: bool) -> int:

@@ -67,15 +67,18 @@ class Inset:
 
     def takes(self, scene, start: dict, size: int) -> bool:
         """Whether this inset can play another pixel of `scene`'s map: one whose axes are angles and rates only
-        changes the start, which its kernels do not hold (a length or mass axis is compiled into them). Taichi
-        never frees a Run's fields and kernels: a new inset a click took 4.6 MB and 3.4 s."""
-        return scene is self.map and size == self.size and all(k[:5] in ("theta", "omega") for k in start)
+        changes the start, which its kernels do not hold (a length or mass axis is compiled into them), where
+        that start is stepped as this one is (dt "auto" and the energy limit follow the start). Taichi never
+        frees a Run's fields and kernels: a new inset a click took 4.6 MB and 3.4 s."""
+        if scene is not self.map or size != self.size or any(k[:5] not in ("theta", "omega") for k in start):
+            return False
+        pixel = pixel_scene(self.map, start, self.size)
+        self.plan = registry.get(pixel.system)(pixel)  # its plan: no Taichi field
+        return (self.plan.h, self.plan.substeps) == (self.run.sim.h, self.run.sim.substeps)
 
     def move(self, start: dict):
-        """Play the pendulum that starts at `start` instead, from its first frame."""
-        pixel = pixel_scene(self.map, start, self.size)
-        q0, v0 = registry.get(pixel.system)(pixel).initial_state()  # its plan: no Taichi field
-        self.begin(start, q0, v0)
+        """Play the pendulum that starts at `start` instead, from its first frame (after takes() said yes)."""
+        self.begin(start, *self.plan.initial_state())
 
     def begin(self, start: dict, q0, v0):
         self.state = (q0, v0)
@@ -123,9 +126,10 @@ def value_text(canvas, kind: str, p: int, t: float) -> str:
 class Explorer:
     """The map on show, its zoom stack, the inset and the mouse; compose() makes the frame the window shows."""
 
-    def __init__(self, scene, arch: str, threads, out, log=say):
-        """out: the output root, where s saves a frame as `render` would write the map on show."""
-        self.arch, self.threads, self.out, self.log = arch, threads, out, log
+    def __init__(self, scene, arch: str, threads, out, log=say, name: str | None = None):
+        """out: the output root, where s saves a frame as `render` would write the map on show; name: the
+        preset's own name, which a zoom's folder starts with (`scene`'s, if not given)."""
+        self.arch, self.threads, self.out, self.log, self.name = arch, threads, out, log, name or scene.name
         self.stack = [scene]  # the scenes zoomed into, as given (before validation promotes a zoom to f64)
         self.cursor = self.press = None
         self.changed = True
@@ -140,7 +144,7 @@ class Explorer:
         self.source = pipeline.Source(scene, arch=self.arch, threads=self.threads)
         self.scene, self.lay = self.source.scene, self.source.canvas.lay
         # a zoom is another scene: its frames go where `render` would write it, OUT/NAME__<its hash>/
-        named = scene if scene is self.stack[0] else output_name(scene, True)
+        named = scene if scene is self.stack[0] else output_name(scene.replace(name=self.name), True)
         self.player = Player(self.source, scene.video.fps, saves_to(named, self.out))
         self.size = self.lay.font or "6x13"  # the decorations' font; a map too small for them: the smaller one
         self.font = self.source.canvas.font or Font(self.size)
@@ -270,9 +274,9 @@ class Explorer:
         return out
 
 
-def explore(scene, arch: str, threads, out, suggest: str, log=say, on_open=None) -> int:
+def explore(scene, arch: str, threads, out, suggest: str, log=say, on_open=None, name: str | None = None) -> int:
     """Open the window on the map and run until q/Esc or the window closes; returns the exit code."""
-    ex = Explorer(scene, arch, threads, out, log)
+    ex = Explorer(scene, arch, threads, out, log, name)
     win = Window(f"pendulum show: {scene.name}", ex.lay.width, ex.lay.height, suggest=suggest)
     if on_open:
         on_open()

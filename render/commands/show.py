@@ -112,7 +112,8 @@ def render_command(args) -> str:
 def run(args) -> int:
     # frames saved with s go where `render` would write this scene: OUT/NAME__<hash>/ when overridden, and
     # never through a symlink or into a file (checked before the window opens, as render checks)
-    scene = output_name(load(args.preset, args.overrides, args.quality), bool(args.overrides or args.quality))
+    loaded = load(args.preset, args.overrides, args.quality)
+    scene = output_name(loaded, bool(args.overrides or args.quality))
     scene = budgeted(scene, args)
     check_out_folder(scene, args.out, files=())
     # what `render` refuses, `show` refuses too: it simulates and certifies the same (a comparison records its
@@ -123,7 +124,7 @@ def run(args) -> int:
     try:
         if scene.fractal:  # a map to explore: click, zoom, back (render/commands/explore.py)
             from .explore import explore
-            return explore(scene, args.arch, args.threads, args.out, suggest, on_open=probe.close)
+            return explore(scene, args.arch, args.threads, args.out, suggest, on_open=probe.close, name=loaded.name)
         source = pipeline.open_source(scene, arch=args.arch, threads=args.threads)  # a comparison: split screen
         return play(source, scene.video.fps, saves_to(scene, args.out), suggest, on_open=probe.close)
     finally:

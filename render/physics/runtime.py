@@ -85,15 +85,21 @@ def writable_cache():
     folder cannot be made (a read-only or missing $HOME, as in some containers): exit code 139 for a finished
     render. Such a process caches its kernels in a folder of its own under the temporary folder, and says so."""
     root = vector_width.cache_root()
-    with contextlib.suppress(OSError):
+    try:  # a file made and removed there: os.access says yes to root on a read-only or immutable folder
         os.makedirs(root, exist_ok=True)
-    if os.access(root, os.W_OK | os.X_OK):
-        return
-    spare = os.path.join(tempfile.gettempdir(), f"pendulum-taichi-cache-{os.getuid()}")
-    with contextlib.suppress(FileExistsError):
-        os.mkdir(spare, 0o700)
-    mode = os.lstat(spare)
-    if not stat.S_ISDIR(mode.st_mode) or mode.st_uid != os.getuid():  # a shared temporary folder: not ours
+        with tempfile.NamedTemporaryFile(dir=root, prefix=".pendulum-probe-"):
+            return
+    except OSError:
+        pass
+    spare = None
+    if hasattr(os, "getuid"):  # one folder a user, kept between runs (Windows has no uid: one a run)
+        spare = os.path.join(tempfile.gettempdir(), f"pendulum-taichi-cache-{os.getuid()}")
+        with contextlib.suppress(FileExistsError):
+            os.mkdir(spare, 0o700)
+        st = os.lstat(spare)
+        if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():  # a shared folder: that name is another's
+            spare = None
+    if spare is None:
         spare = tempfile.mkdtemp(prefix="pendulum-taichi-cache-")
     os.environ["TI_OFFLINE_CACHE_FILE_PATH"] = spare
     print(f"warning: Taichi's kernel cache {root} cannot be written; caching kernels in {spare} "

@@ -128,18 +128,23 @@ def together(folder: Path | None = None):
     """A command's files appear together or not at all: within the block, each file replacing() and
     write_atomic() finish stays in its temporary; all are published, in the order written, when the block
     succeeds, and none is when it fails (their temporaries are removed). A chart written before a failing
-    table is not left behind without it. `folder`, where they go, is made here if missing, and removed again
-    if the block fails and leaves it empty: a failed command leaves no empty folder behind either."""
-    made = folder is not None and not os.path.lexists(folder)
+    table is not left behind without it. `folder`, where they go, is made here if missing (with its missing
+    parents), and what was made is removed again if the block fails and leaves it empty: a failed command
+    leaves no empty folder behind either."""
+    made = []  # the folders made here, the deepest first
     if folder is not None:
+        here = Path(folder)
+        while not os.path.lexists(here):
+            made.append(here)
+            here = here.parent
         Path(folder).mkdir(parents=True, exist_ok=True)
     try:
         with _together():
             yield
     except BaseException:
-        if made:
+        for path in made:
             with contextlib.suppress(OSError):  # not empty: something else was put there meanwhile
-                Path(folder).rmdir()
+                path.rmdir()
         raise
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import os
 import re
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 
 from ..errors import BatchError, SceneError, SimulationError
 
@@ -51,7 +51,8 @@ def env_address() -> str | None:
 
 def connect(address: str):
     """A Client of the Dask scheduler at `address`, which has a worker; BatchError (exit 1) when it cannot be
-    reached or has had no worker for WORKERS_TIMEOUT_S (its tiles would wait for one forever, saying nothing)."""
+    reached or has had no worker for WORKERS_TIMEOUT_S (its tiles would wait for one forever, saying nothing;
+    an adaptive cluster must so have one up within that time)."""
     from dask.distributed import Client
     try:
         client = Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
@@ -60,28 +61,40 @@ def connect(address: str):
     try:
         client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
     except Exception:  # noqa: BLE001 - TimeoutError, or the scheduler gone meanwhile
-        client.close()
+        close(client)
         raise BatchError(f"the Dask scheduler at {address} has no worker (waited {WORKERS_TIMEOUT_S:g} s); start "
                          f"one with `dask worker {address}`") from None
     return client
 
 
+def close(client):
+    """Close a Client whose scheduler may be gone: the error being reported, not close()'s, is the one line."""
+    with suppress(Exception):
+        client.close()
+
+
 @contextmanager
 def quiet():
-    """distributed's loggers and warnings held back while a cluster works for this process: a lost scheduler
+    """distributed's logging and warnings held back while a cluster works for this process: a lost scheduler
     is reported as one line by collect(), not after 25 lines of its client's traceback, and a LocalCluster's
-    scheduler starts an HTTP server on 8787 even without a dashboard, and warns where that port is taken."""
+    scheduler starts an HTTP server on 8787 even without a dashboard, and warns where that port is taken.
+    distributed gives its loggers (distributed.client, .gc, ...) levels of their own and stops their
+    propagation, so each is quieted, as are tornado's."""
     import logging
     import warnings
-    log = logging.getLogger("distributed")
-    level = log.level
-    log.setLevel(logging.CRITICAL)
+    import distributed  # noqa: F401 - its import configures the loggers quieted here
+    names = ["distributed", "tornado", *(n for n in logging.root.manager.loggerDict
+                                         if n.partition(".")[0] in ("distributed", "tornado"))]
+    levels = {n: logging.getLogger(n).level for n in names}
+    for n in names:
+        logging.getLogger(n).setLevel(logging.CRITICAL)
     try:
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message=r"Port \d+ is already in use", category=UserWarning)
             yield
     finally:
-        log.setLevel(level)
+        for n, level in levels.items():
+            logging.getLogger(n).setLevel(level)
 
 
 def check(scene, how: str):
@@ -101,19 +114,19 @@ def cluster(address: str | None, workers: int | None):
     """A Client: of the scheduler at `address`, or of a LocalCluster of `workers` single-threaded worker
     processes on loopback, closed after the block."""
     if address:
-        client = connect(address)
-        try:
-            with quiet():
+        with quiet():
+            client = connect(address)
+            try:
                 yield client
-        finally:
-            client.close()
+            finally:
+                close(client)
         return
     import logging
     import tempfile
     import dask
     from dask.distributed import Client, LocalCluster
     # its scratch space (lock files) in a folder removed after, not left in $TMPDIR/dask-scratch-space
-    with tempfile.TemporaryDirectory(prefix="pendulum-dask-") as scratch, quiet(), \
+    with tempfile.TemporaryDirectory(prefix="pendulum-dask-", ignore_cleanup_errors=True) as scratch, quiet(), \
             dask.config.set({"temporary-directory": scratch}), \
             LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                          dashboard_address=None, silence_logs=logging.ERROR) as local, \
