@@ -35,15 +35,21 @@ def force_and_energy(sim: ti.template(), acc: ti.types.ndarray(), e: ti.types.nd
         e[i] = sim.energy(sim.q[i], sim.v[i])
 
 
-def test_accelerations_and_energy_match_the_chain_reference_at_random_states():
-    scene = triple(64)
-    sim = Run(scene).sim
-    rng = np.random.default_rng(11)
-    q, v = rng.uniform(-np.pi, np.pi, (64, 3)), rng.normal(0, 2.0, (64, 3))
+def at_random_states(scene, seed: int):
+    """(q, v, the kernel's accelerations, its energies) at random states of `scene`'s pendulums."""
+    sim, n = Run(scene).sim, scene.pendulums.count
+    rng = np.random.default_rng(seed)
+    q, v = rng.uniform(-np.pi, np.pi, (n, 3)), rng.normal(0, 2.0, (n, 3))
     sim.q.from_numpy(q)
     sim.v.from_numpy(v)
-    acc, e = np.zeros((64, 3)), np.zeros(64)
+    acc, e = np.zeros((n, 3)), np.zeros(n)
     force_and_energy(sim, acc, e)
+    return q, v, acc, e
+
+
+def test_accelerations_and_energy_match_the_chain_reference_at_random_states():
+    scene = triple(64)
+    q, v, acc, e = at_random_states(scene, 11)
     p = reference.params(scene)
     np.testing.assert_allclose(acc, reference.chain_accel(q, v, p), rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(e, reference.chain_energy(q, v, p), rtol=1e-12, atol=1e-10)
@@ -85,14 +91,7 @@ def test_accelerations_match_a_lagrangian_of_the_bobs_positions():
     """Apart from reference.py: the kernel's accelerations at random states against the Lagrangian of the
     bobs' positions, differentiated numerically: within 1e-7 (measured 7.6e-9, the differences' own error, at
     accelerations up to 51 rad/s²; the masses swapped are 1.8 off)."""
-    scene = triple(16)
-    sim = Run(scene).sim
-    rng = np.random.default_rng(5)
-    q, v = rng.uniform(-np.pi, np.pi, (16, 3)), rng.normal(0, 2.0, (16, 3))
-    sim.q.from_numpy(q)
-    sim.v.from_numpy(v)
-    acc, e = np.zeros((16, 3)), np.zeros(16)
-    force_and_energy(sim, acc, e)
+    q, v, acc, _ = at_random_states(triple(16), 5)
     want = np.array([lagrangian_accel(qi, vi, PEND["masses"], PEND["lengths"], PEND["gravity"])
                      for qi, vi in zip(q, v)])
     np.testing.assert_allclose(acc, want, rtol=1e-7, atol=1e-7)
