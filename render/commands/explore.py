@@ -69,7 +69,8 @@ class Inset:
         """Whether this inset can play another pixel of `scene`'s map: one whose axes are angles and rates only
         changes the start, which its kernels do not hold (a length or mass axis is compiled into them), where
         that start is stepped as this one is (dt "auto" and the energy limit follow the start). Taichi never
-        frees a Run's fields and kernels: a new inset a click took 4.6 MB and 3.4 s."""
+        frees a Run's fields and kernels: on fractal_flip at 320x180, 20 clicks took 3.0 s and 13 MB more
+        resident memory a click with a new inset each, 6 ms and 0.03 MB reusing one (a script not kept)."""
         if scene is not self.map or size != self.size or any(k[:5] not in ("theta", "omega") for k in start):
             return False
         pixel = pixel_scene(self.map, start, self.size)
