@@ -10,7 +10,7 @@ import pytest
 
 from conftest import ocr_line
 from render.config.scene import load
-from render.video import downscale, encode, gif, palette, pipeline
+from render.video import downscale, encode, gif, palette, pipe, pipeline
 
 # A frame larger than the GIF's and a rate higher than its own, so the GIF has a canvas of its own; short, since
 # every render compiles its kernels.
@@ -28,7 +28,7 @@ def render(scene, out, threads=1):
     index of the video frame being written then, or None in close())) and the GIF frames the pipeline handed the
     encoder (video frame index -> frame)."""
     piped, small, writing = [], {}, [None]
-    real_init, real_write = encode._Target.__init__, encode.Encoder.write
+    real_init, real_write = pipe.Pipe.__init__, encode.Encoder.write
 
     def init(self, *a, **kw):
         real_init(self, *a, **kw)
@@ -47,7 +47,7 @@ def render(scene, out, threads=1):
             writing[0] = None
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(encode._Target, "__init__", init)
+        mp.setattr(pipe.Pipe, "__init__", init)
         mp.setattr(encode.Encoder, "write", write)
         pipeline.render(scene, out, threads=threads)
     d = scene.out_dir(out)

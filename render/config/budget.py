@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 
 from ..video import audio
-from ..video.encode import QUEUE_FRAMES
+from ..video.pipe import QUEUE_FRAMES
 from ..video.mp4 import AUDIO_KBPS
 from ..errors import SceneError
 from ..physics.integrators import AUTO_DT, check_substeps

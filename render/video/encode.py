@@ -3,14 +3,12 @@
 Each format has its own ffmpeg process writing to a hidden temporary file beside the final one; close()
 renames them into place only when every process succeeded, abort() removes them.
 
-Pipelining: each ffmpeg process has its own writer thread fed from its own small bounded queue, so
-simulating and drawing the next frames overlaps with encoding the previous ones, a slow GIF never stalls the
-MP4 (or the other way round), and memory stays flat (the queues share the frame arrays, they do not copy
-them). The pipes are enlarged so a writer hands over a frame in a few system calls.
+Pipelining: each ffmpeg process is fed by a thread of its own from a small bounded queue (render/video/pipe.py),
+so simulating and drawing the next frames overlaps with encoding the previous ones, a slow GIF never stalls the
+MP4 (or the other way round), and memory stays flat.
 """
 from __future__ import annotations
 
-import errno
 import os
 import queue
 import subprocess
@@ -22,36 +20,9 @@ import imageio_ffmpeg
 import numpy as np
 
 from . import gif, mp4, palette
+from .pipe import Pipe, ends, os_error
 from .atomic import publish, temp_beside
 from ..errors import EncodeError
-
-try:
-    import fcntl
-except ImportError:  # not POSIX: default pipe sizes
-    fcntl = None
-
-QUEUE_FRAMES = 6  # per ffmpeg process: at most ~14 distinct 720p frames (2.8 MB each) are ever waiting
-PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe (/proc/sys/fs/pipe-max-size)
-F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call fails harmlessly
-
-
-# What ffmpeg reports in the system's own words (av_strerror is strerror) when the file system fails it: then
-# the user reads that reason and the file, as for any other write, not ffmpeg's account of its muxer.
-FILE_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM,
-               errno.ENOENT, errno.ESTALE)
-
-
-def os_error(log: str) -> int | None:
-    """The errno of the first file-system error an ffmpeg log names, if any."""
-    found = [(log.find(os.strerror(code)), code) for code in FILE_ERRORS if os.strerror(code) in log]
-    return min(found)[1] if found else None
-
-
-def _ends(log: str) -> str:
-    """An ffmpeg log's first and last lines, or its one line."""
-    lines = [line.strip() for line in log.splitlines() if line.strip()]
-    return lines[0] if len(lines) == 1 else f"{lines[0]} ... {lines[-1]}"
-
 
 class _Still:
     """The "png" format: the last frame as a PNG (a map at its end time), written when the video closes."""
@@ -67,48 +38,6 @@ class _Still:
             raise OSError(e.errno, e.strerror, str(self.final)) from e
 
 
-class _Target:
-    """One ffmpeg process, the thread that feeds it, and where its output goes."""
-
-    def __init__(self, final: Path, tmp: Path, proc: subprocess.Popen, log, repeats: list[int] | None = None,
-                 small: tuple[int, int] | None = None, planar: bool = False):
-        self.final, self.tmp, self.proc, self.log = final, tmp, proc, log
-        self.planar = planar  # fed yuv420p (render/video/yuv.py), not rgb24
-        self.repeats = repeats  # per frame, how many times it goes to this ffmpeg (None: once each)
-        self.small = small  # the GIF's (width, height): it is fed frames of that size only
-        self.kept: list | None = None  # a GIF's frames, mapped to its palette at the end (Encoder._gif)
-        self.step, self.rate = 1, None  # then every step-th is fed, for the palette; the GIF's frames a second
-        self.last_counted = -1  # the index of the last of those
-        self.ended = False  # its end (None) queued: no more frames for this ffmpeg
-        self.queue: queue.Queue = queue.Queue(QUEUE_FRAMES)
-        self.error: BaseException | None = None
-        try:
-            fcntl.fcntl(proc.stdin.fileno(), F_SETPIPE_SZ, PIPE_BYTES)
-        except (OSError, AttributeError):
-            pass  # a smaller pipe only means more system calls
-        self.thread = threading.Thread(target=self._pump, name=f"encode-{final.suffix[1:]}", daemon=True)
-        self.thread.start()
-
-    def _pump(self):
-        fd = self.proc.stdin.fileno()
-        while True:
-            frame = self.queue.get()
-            if frame is None:
-                try:
-                    self.proc.stdin.close()  # EOF: ffmpeg flushes (a GIF's palette needs every frame it counts)
-                except OSError:
-                    pass
-                return
-            if self.error is not None:
-                continue  # keep draining so the producer never blocks on a dead encoder
-            try:
-                view = memoryview(np.ascontiguousarray(frame)).cast("B")
-                while view:  # os.write releases the GIL while it blocks on the pipe
-                    view = view[os.write(fd, view):]
-            except BaseException as e:  # a dead ffmpeg: report it from the main thread
-                self.error = e
-
-
 class Encoder:
     """Writes `frames` to out_dir/NAME.<fmt> for each format: write() each frame, then close(), or abort()."""
 
@@ -119,7 +48,7 @@ class Encoder:
         if planar:
             from . import yuv  # Taichi: not for a plan (render/config/budget.py reads this module)
             self.yuv = yuv if yuv.fits(video.width, video.height) else None
-        self.targets: list[_Target] = []
+        self.targets: list[Pipe] = []
         self.written = 0
         self.stills: list[_Still] = []
         self.size = (video.width, video.height)
@@ -148,7 +77,7 @@ class Encoder:
                     tmp.unlink(missing_ok=True)
                     log.close()
                     raise
-                t = _Target(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif" else None,
+                t = Pipe(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif" else None,
                             gif.size(video) if fmt == "gif" else None, planar)
                 if own:
                     t.kept, t.step, t.rate = [], palette.palette_step(video), rate
@@ -277,13 +206,13 @@ class Encoder:
             s.tmp.unlink(missing_ok=True)
         self.targets, self.stills = [], []
 
-    def _mux(self, t: _Target, rate: int, samples: np.ndarray):
+    def _mux(self, t: Pipe, rate: int, samples: np.ndarray):
         """The track into the finished MP4 (mp4.mux)."""
         code = mp4.mux(t.final, t.tmp, t.log, rate, samples)
         if code:
             raise self._failure("failed adding the audio", f"exit status {code}")
 
-    def _gif(self, t: _Target, colours: np.ndarray):
+    def _gif(self, t: Pipe, colours: np.ndarray):
         """A GIF's kept frames mapped to its palette and written at t.tmp (render/video/dither.py)."""
         from . import dither  # Taichi: not for a plan (render/config/budget.py reads this module)
         code, t.error = dither.write(t.kept, colours, t.small, t.rate, t.tmp, t.log)
@@ -302,10 +231,10 @@ class Encoder:
             code = os_error(log)
             if code is not None:
                 return OSError(code, os.strerror(code), str(t.final))
-        return EncodeError(f"ffmpeg {how}: {' | '.join(_ends(x) for x in logs if x.strip()) or fallback}")
+        return EncodeError(f"ffmpeg {how}: {' | '.join(ends(x) for x in logs if x.strip()) or fallback}")
 
     @staticmethod
-    def _log(t: _Target) -> str:
+    def _log(t: Pipe) -> str:
         t.log.seek(0)
         return t.log.read().decode(errors="replace").strip()
 
