@@ -191,7 +191,8 @@ def test_watchdog_names_energy_drift(tmp_path):
 def test_interrupted_render_leaves_no_files(tmp_path, sig, code):
     proc = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
                              "--no-progress", "--set", "video.width=320", "--set", "video.height=180",
-                             "--name", "interrupted"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                             # a minute of video: however fast the machine, the signal comes while it encodes
+                             "--set", "video.duration=60", "--name", "interrupted"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
                             # started as a non-interactive shell starts a background job: SIGINT ignored, which
                             # the render must undo (it exited 0, rendered to the end, before cli.main did)
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
