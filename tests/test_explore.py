@@ -113,6 +113,32 @@ def test_a_second_click_plays_its_pixel_in_the_same_inset_as_a_new_one_would(tmp
         assert np.array_equal(ex.inset.frame, fresh.frame)
 
 
+def test_zooming_in_and_back_out_keeps_no_earlier_maps_kernels_or_fields(tmp_path):
+    """Taichi frees a map's fields and compiled kernels only with its runtime: with one runtime for every map, each
+    zoom and back left the last map's behind (the process grew to 490 MB in 60 of them, benchmarks/explore_zooms.py).
+    Each map now has a runtime of its own, so after any number of zooms and backs Taichi holds what one map needs."""
+    import gc
+
+    from taichi.lang import impl
+
+    def held():  # Taichi's compiled kernels and trees of fields
+        gc.collect()
+        rt = impl.get_runtime()
+        return sum(len(k.compiled_kernels) for k in rt.kernels), rt.prog.get_snode_tree_size()
+
+    scene = load("fractal_flip", ["video.width=64", "video.height=64", "video.fps=10", "video.duration=1"])
+    ex = Explorer(scene, "cpu", None, tmp_path, log=[].append)
+    ex.player.tick(1e9)  # a frame drawn: every kernel of a map has run
+    one_map = held()
+    for _ in range(3):
+        ex.mouse("press", (8, 8))
+        ex.mouse("release", (40, 40))
+        ex.player.tick(1e9)
+        ex.key("b")
+        ex.player.tick(1e9)
+    assert held() == one_map and min(one_map) > 0
+
+
 def test_a_map_too_small_for_an_inset_says_so_on_a_click(tmp_path):
     said = []
     scene = load("fractal_flip", ["video.width=40", "video.height=16", "video.fps=10", "video.duration=1"])
