@@ -211,6 +211,38 @@ def test_a_scheduler_without_workers_is_one_line_not_a_silent_wait(tmp_path, mon
     assert time.perf_counter() - t < 30 and not (tmp_path / "out").exists()
 
 
+def test_a_cluster_that_loses_every_worker_mid_render_is_one_line_not_a_silent_wait(tmp_path, monkeypatch):
+    """Its one worker retired while a band runs: the scheduler would hold the bands left for a worker forever.
+    After WORKERS_TIMEOUT_S with no worker the render fails, saying so, and writes nothing."""
+    monkeypatch.setattr(tiled, "WORKERS_TIMEOUT_S", 2.0)
+    with tiled.quiet(), distributed.LocalCluster(n_workers=1, processes=True, threads_per_worker=1, host="127.0.0.1",
+                                                 dashboard_address=None) as one, \
+            distributed.Client(one, set_as_default=False) as client:
+        client.wait_for_workers(1, timeout=60)
+        retired, stop = threading.Event(), threading.Event()
+
+        def retire():  # as soon as a band runs, the cluster scales to no worker
+            while not stop.is_set():
+                if any(str(k).startswith("pendulum-tile-") for keys in client.processing().values() for k in keys):
+                    one.scale(0)
+                    retired.set()
+                    return
+                time.sleep(0.01)
+
+        thread = threading.Thread(target=retire, daemon=True)
+        thread.start()
+        try:
+            code, err = cli("render", "fractal_flip", *(a for s in SETS for a in ("--set", s)), "--out",
+                            tmp_path / "out", "--scheduler", one.scheduler_address, "--tiles", 2, "--no-progress")
+        finally:
+            stop.set()
+            thread.join(5)
+    assert retired.is_set(), "no band was seen running"
+    assert code == 1 and err.count("\n") == 1, err
+    assert "the Dask cluster has had no worker for 2 s, with bands of the map still to run" in err, err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*")), list((tmp_path / "out").rglob("*"))
+
+
 def test_assembly_undoes_the_deltas():
     """The bands' frames travel as XOR deltas, zlib-compressed: they come back exactly."""
     sc = scene()

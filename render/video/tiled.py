@@ -173,22 +173,34 @@ class TiledSource:
         self.canvas = self  # what pipeline.render asks a map's canvas for: summary(), result()
 
     def collect(self, futures: list, client) -> list[dict]:
-        """The bands' results, top first, as they finish; the first failure cancels the others and raises."""
+        """The bands' results, top first, as they finish; the first failure cancels the others and raises. A
+        cluster that has had no worker for WORKERS_TIMEOUT_S while bands wait (its workers died or were retired
+        for good) fails the render too: the scheduler would hold them for a worker forever, saying nothing."""
+        import threading
+
         from dask.distributed import as_completed
 
         index = {f.key: i for i, f in enumerate(futures)}
         results = [None] * len(futures)
+        done, lost = threading.Event(), threading.Event()
+        watch = threading.Thread(target=_watch_workers, args=(client, futures, done, lost), daemon=True)
+        watch.start()
         try:
             for fut in as_completed(futures, loop=client.loop):
                 try:
                     r = fut.result()
                 except Exception as e:  # noqa: BLE001 - e.g. KilledWorker: a band's workers kept dying
+                    if lost.is_set():
+                        raise BatchError(f"{self.scene.name}: the Dask cluster has had no worker for "
+                                         f"{WORKERS_TIMEOUT_S:g} s, with bands of the map still to run") from None
                     raise BatchError(f"{self.scene.name}: a tile could not be rendered on the cluster: "
                                      f"{type(e).__name__}: {e}") from None
                 if "error" in r:
                     raise SimulationError(r["error"])
                 results[index[fut.key]] = r
         finally:
+            done.set()
+            watch.join()
             client.cancel(futures)  # a no-op for finished bands; stops the others when one failed
         return results
 
@@ -207,3 +219,22 @@ class TiledSource:
         frame = self.assembly.frame(self.index, out)
         self.timings["draw"] += time.perf_counter() - t
         return frame
+
+
+def _watch_workers(client, futures: list, done, lost, every_s: float = 1.0):
+    """Until `done`: where the cluster has had no worker for WORKERS_TIMEOUT_S, set `lost` and cancel `futures`
+    (their results then raise, and TiledSource.collect says why)."""
+    alone = None
+    while not done.wait(every_s):
+        try:
+            workers = client.nthreads()
+        except Exception:  # noqa: BLE001 - the scheduler gone: the futures fail by themselves
+            return
+        if workers:
+            alone = None
+        elif alone is None:
+            alone = time.monotonic()
+        elif time.monotonic() - alone >= WORKERS_TIMEOUT_S:
+            lost.set()
+            client.cancel(futures)
+            return
