@@ -219,6 +219,95 @@ def test_files_written_together_appear_together_or_not_at_all(tmp_path):
     assert (tmp_path / "alone.txt").read_bytes() == b"x"
 
 
+def test_a_publish_that_fails_halfway_puts_the_earlier_result_back(tmp_path, monkeypatch):
+    """atomic.publish_all: the third rename fails after two new files had replaced an earlier run's; those two are
+    put back, the new ones are gone, and nothing hidden is left (neither temporaries nor the kept links)."""
+    import errno
+    from render.video import atomic
+    names = ["a.mp4", "b.gif", "metadata.json"]
+    for n in names:
+        (tmp_path / n).write_text(f"old {n}")
+    pairs = []
+    for n in names:
+        tmp = atomic.temp_beside(tmp_path / n)
+        tmp.write_text(f"new {n}")
+        pairs.append((tmp, tmp_path / n))
+    real, calls = atomic.publish, []
+
+    def publish(tmp, path):
+        calls.append(path.name)
+        if len(calls) == 3:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        real(tmp, path)
+
+    monkeypatch.setattr(atomic, "publish", publish)
+    with pytest.raises(OSError, match=os.strerror(errno.ENOSPC)):
+        atomic.publish_all(pairs)
+    assert calls == names
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)  # nothing hidden left
+    assert all((tmp_path / n).read_text() == f"old {n}" for n in names)
+    monkeypatch.setattr(atomic, "publish", real)
+    fresh = tmp_path / "fresh"  # no earlier result: a failure leaves none of the new one
+    fresh.mkdir()
+    pairs = [(atomic.temp_beside(fresh / n), fresh / n) for n in names]
+    calls.clear()
+    monkeypatch.setattr(atomic, "publish", publish)
+    with pytest.raises(OSError):
+        atomic.publish_all(pairs)
+    assert not list(fresh.iterdir())
+
+
+def test_a_signal_during_the_renames_comes_after_them(tmp_path):
+    """SIGINT as the renames go (the second one here) is delivered when all are done: a render is published whole,
+    then interrupted, never cut between its video and its metadata.json."""
+    import signal
+    from render.video import atomic
+    pairs = [(atomic.temp_beside(tmp_path / n), tmp_path / n) for n in ("a.mp4", "metadata.json")]
+    real, seen = atomic.publish, []
+
+    def publish(tmp, path):
+        if path.name == "metadata.json":
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)  # the handler would run here, between two bytecodes
+        real(tmp, path)
+        seen.append(path.name)
+
+    atomic.publish, old = publish, atomic.publish
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            atomic.publish_all(pairs)
+    finally:
+        atomic.publish = old
+    assert seen == ["a.mp4", "metadata.json"] and sorted(p.name for p in tmp_path.iterdir()) == ["a.mp4",
+                                                                                                   "metadata.json"]
+
+
+def test_a_render_that_fails_as_it_publishes_leaves_the_earlier_render_whole(tmp_path, monkeypatch):
+    """Into OUT/NAME holding a complete render: its metadata.json's rename fails after the new MP4 and GIF had
+    replaced the old ones. The folder holds the earlier render again, byte for byte, and nothing else."""
+    import errno
+    from render.config.scene import load
+    from render.video import atomic, pipeline
+
+    def scene(seconds):
+        return load("classic", ["video.width=64", "video.height=36", f"video.duration={seconds}", "video.fps=10",
+                                'video.formats=["mp4", "gif"]']).replace(name="x")
+
+    pipeline.render(scene(0.5), tmp_path)
+    before = {p.name: p.read_bytes() for p in (tmp_path / "x").iterdir()}
+    real = atomic.publish
+
+    def publish(tmp, path):
+        if path.name == "metadata.json":
+            raise OSError(errno.EIO, os.strerror(errno.EIO), str(path))
+        real(tmp, path)
+
+    monkeypatch.setattr(atomic, "publish", publish)
+    with pytest.raises(OSError, match=os.strerror(errno.EIO)):
+        pipeline.render(scene(0.8), tmp_path)
+    assert {p.name: p.read_bytes() for p in (tmp_path / "x").iterdir()} == before
+
+
 def test_a_gallery_whose_page_is_a_folder_is_refused_before_any_poster(tmp_path):
     r = run_cli("render", "classic", *TINY, "--name", "x", "--out", tmp_path / "out")
     assert r.returncode == 0, r.stderr

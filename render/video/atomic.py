@@ -13,8 +13,10 @@ import errno
 import hashlib
 import os
 import re
+import signal
 import socket
 import tempfile
+import threading
 import time
 import zlib
 from contextlib import contextmanager
@@ -87,6 +89,69 @@ def publish(tmp: Path, path: Path):
         os.replace(tmp, path)
     except OSError as e:  # name the file the user asked for, not our hidden temporary
         raise OSError(e.errno, e.strerror, str(path)) from e
+
+
+def publish_all(pairs: list[tuple[Path, Path]]):
+    """Rename each finished temporary onto its final path, all of them or none: a render's videos, data and
+    metadata.json are one result. A final file already there (an earlier run's) is first kept under a hidden
+    hard link, and put back if a later rename fails, so a failure leaves the earlier result whole, never half of
+    each; without hard links (a file system that has none) a failure leaves none of the files it replaced.
+    SIGINT and SIGTERM that arrive meanwhile are delivered when the renames are done (signals_held)."""
+    with signals_held():
+        kept: list[Path | None] = []
+        try:
+            for tmp, path in pairs:
+                kept.append(_keep(path))
+            for i, (tmp, path) in enumerate(pairs):
+                try:
+                    publish(tmp, path)
+                except BaseException:
+                    for (_, done), old in zip(pairs[:i], kept):  # put the earlier result back, or none of this one
+                        if old is not None:
+                            os.replace(old, done)
+                        else:
+                            done.unlink(missing_ok=True)
+                    for waiting, _ in pairs[i:]:
+                        waiting.unlink(missing_ok=True)
+                    raise
+        finally:
+            for old in kept:
+                if old is not None:
+                    old.unlink(missing_ok=True)
+
+
+def _keep(path: Path) -> Path | None:
+    """A hidden hard link to the file at `path`, if there is one (swept like a temporary if we die)."""
+    if not path.is_file() or path.is_symlink():
+        return None
+    link = temp_beside(path)
+    try:
+        link.unlink()
+        os.link(path, link)
+    except OSError:
+        link.unlink(missing_ok=True)
+        return None
+    return link
+
+
+@contextmanager
+def signals_held():
+    """SIGINT and SIGTERM arriving within the block are delivered when it ends, so that a run of renames is
+    never cut in two. Only the main thread can set handlers: elsewhere the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    for s in before:
+        signal.signal(s, lambda sig, frame: caught.append(sig))
+    try:
+        yield
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
+        if caught:
+            signal.raise_signal(caught[0])  # as it would have come: its handler (KeyboardInterrupt, ...) runs now
 
 
 # The files finished within together()'s block, (temporary, final), in this thread or task; None outside one.
@@ -165,15 +230,7 @@ def _together():
             for tmp, _ in held:
                 tmp.unlink(missing_ok=True)
             raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
-    for i, (tmp, path) in enumerate(held):
-        try:
-            publish(tmp, path)
-        except BaseException:  # the files published before it go too: together or not at all
-            for waiting, _ in held[i:]:
-                waiting.unlink(missing_ok=True)
-            for _, published in held[:i]:
-                published.unlink(missing_ok=True)
-            raise
+    publish_all(held)  # together or not at all, the files they replace kept until then
 
 
 def write_atomic(path: Path, data: bytes | str):

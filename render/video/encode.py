@@ -21,7 +21,7 @@ import numpy as np
 
 from . import gif, mp4, palette
 from .pipe import Pipe, ends, os_error
-from .atomic import publish, temp_beside
+from .atomic import publish_all, temp_beside
 from ..errors import EncodeError
 
 class _Still:
@@ -182,11 +182,13 @@ class Encoder:
         """(temporary, final) of each finished file, after close(publish=False)."""
         return [(t.tmp, t.final) for t in [*self.targets, *self.stills]]
 
-    def publish(self):
-        """Rename the finished files into place (after close(publish=False))."""
-        for tmp, final in self.done():
-            publish(tmp, final)
-        self.targets, self.stills = [], []
+    def publish(self, *others: tuple[Path, Path]):
+        """Rename the finished files into place (after close(publish=False)), with the caller's own finished
+        (temporary, final) pairs: all of them or none (atomic.publish_all)."""
+        try:
+            publish_all(self.done() + list(others))
+        finally:
+            self.targets, self.stills = [], []  # published, or removed by publish_all
 
     def abort(self):
         """Stop ffmpeg and remove the temporary files; safe to call more than once."""

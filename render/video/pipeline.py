@@ -14,7 +14,7 @@ from . import audio
 from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
-from .atomic import digest, naming, publish, replacing, temp_beside
+from .atomic import digest, naming, replacing, signals_held, temp_beside
 from .files import read_regular
 from .metadata import integrator_meta, metadata, run_meta
 
@@ -251,11 +251,10 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
             with naming(pending[-1][1]):
                 pending[-1][0].write_text(json.dumps(meta, indent=2) + "\n")
             stale = superseded(out_dir, scene.name, sizes)
-            enc.publish()
-            for tmp, final in pending:
-                publish(tmp, final)
-            for path in stale:
-                path.unlink(missing_ok=True)
+            with signals_held():  # an interrupt waits for the folder to hold one whole render, the new one
+                enc.publish(*pending)  # all or none: never a new video beside an earlier run's metadata
+                for path in stale:
+                    path.unlink(missing_ok=True)
         except BaseException:
             enc.abort()
             for tmp, _ in pending:
