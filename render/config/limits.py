@@ -32,8 +32,8 @@ EFFECTS = ("rods", "springs", "bobs", "trails", "damping", "energy", "fractal", 
 PALETTES = ("fan", "rainbow")  # video.palette: how pendulum i is coloured (render/draw/raster.py)
 LINK_EFFECTS = {"rods": "rod", "springs": "spring"}  # effect -> the kind of link (System.LINKS) it draws
 MAX_PENDULUMS = 4_000_000  # ~0.5 GB of f64 state and work fields; beyond that a 24 GB machine struggles
-# A map's pendulums hold no trails and no HUD: a 3840x2160 flip map (a 2058² plot) is 4.2 M, an 8K one 16.9 M,
-# about 0.6 GB of f32 state and event fields (and a tiled render splits them over its workers)
+# A map's pendulums hold no trails and no HUD: a 3840x2160 flip map (a 2058² plot) is 4.2 M, 16.9 M at 4 samples a
+# pixel (which MAX_PENDULUMS refuses: a supersampled map is held to it), about 0.6 GB of f32 state and event fields (and a tiled render splits them over its workers)
 MAX_MAP_PENDULUMS = 20_000_000
 MAX_PIXELS = 3840 * 2160
 # The name becomes a folder and the files NAME.mp4 and .NAME.mp4.<owner>.<random>.part beside it; 100

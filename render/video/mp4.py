@@ -32,7 +32,8 @@ PRESET, CRF, ROI_QOFFSET = "superfast", "32", -0.3
 ONE_THREAD_CPUS = 2  # see x264_threads()
 REACH = 0.46  # of the frame's height: the radius of the circle the canvas draws the pendulums in
 # The `audio` effect's track (render/video/audio.py): ffmpeg's own AAC encoder (the bundled build has no libfdk),
-# at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its 11.25 MB of picture.
+# at 48 kHz and 128 kb/s for two channels: 320 kB for a 20 s video beside its
+# 12 MB of picture (rigid_chaos, docs/output-format.md).
 AUDIO_CODEC, AUDIO_RATE, AUDIO_KBPS = "aac", 48_000, 128
 
 
