@@ -165,6 +165,19 @@ def test_simulate_to_a_full_disk_fails_with_one_line_and_leaves_nothing(tmp_path
     assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
 
 
+@pytest.mark.parametrize("fmt, limit", [("mp4", 100_000), ("gif", 400_000)])
+def test_a_video_past_the_file_size_limit_is_named_as_the_os_says(tmp_path, fmt, limit):
+    """RLIMIT_FSIZE as a full disk: ffmpeg's write past it fails with EFBIG, and the one line names the file the
+    user asked for. ffmpeg had SIGXFSZ's default action restored by Popen and died of the signal, saying nothing:
+    "ffmpeg failed: exit status -25" (the MP4) or "[Errno 32] Broken pipe" (the GIF, whose pipe it left)."""
+    env = {**os.environ, "TI_OFFLINE_CACHE_FILE_PATH": str(tmp_path / "taichi-cache")}
+    r = run_user("render", "seed_rigid", "--out", "out", "--no-progress", "--set", "video.width=320",
+                 "--set", "video.height=180", "--set", "video.duration=4", "--set", f'video.formats=["{fmt}"]',
+                 cwd=tmp_path, fsize=limit, env=env)
+    one_line(r, 1, "failed", "File too large", "out/seed_rigid__", f".{fmt}")
+    assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
+
+
 def test_a_render_that_fails_after_its_videos_are_finished_publishes_none_of_them(tmp_path, monkeypatch):
     """The MP4, GIF, still and map data are finished in their temporaries and published only with metadata.json:
     a failure in between (a full disk as the metadata is written) leaves none of them, and no temporary."""

@@ -21,6 +21,7 @@ import taichi as ti
 
 from ..physics import runtime
 from . import palette
+from .pipe import RESTORE_SIGNALS
 
 BATCH = 16  # frames mapped in one launch: one wake-up of the thread pool for several
 CELL_BITS = 3  # cells of 8 levels a side
@@ -99,7 +100,7 @@ def write(frames: list, colours: np.ndarray, size: tuple[int, int], rate: int, p
     cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo",
            "-pix_fmt", "pal8", "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-loop", "0", "-f", "gif", path]
     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
-                            start_new_session=True)
+                            start_new_session=True, restore_signals=RESTORE_SIGNALS)
     error = None
     try:
         mapper, pal = Mapper(colours), palette.pal8(colours)

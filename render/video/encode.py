@@ -20,6 +20,7 @@ import imageio_ffmpeg
 import numpy as np
 
 from . import gif, mp4, palette
+from . import pipe
 from .pipe import Pipe, ends, os_error
 from .atomic import publish_all, temp_beside
 from ..errors import EncodeError
@@ -72,7 +73,8 @@ class Encoder:
                        "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-an", *out]
                 try:
                     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=log, start_new_session=True,
-                                            stdout=subprocess.PIPE if own else subprocess.DEVNULL)
+                                            stdout=subprocess.PIPE if own else subprocess.DEVNULL,
+                                            restore_signals=pipe.RESTORE_SIGNALS)
                 except BaseException:  # (start_new_session: Ctrl-C reaches us, and we clean up)
                     tmp.unlink(missing_ok=True)
                     log.close()

@@ -27,6 +27,7 @@ import imageio_ffmpeg
 import numpy as np
 
 from .atomic import temp_beside
+from .pipe import RESTORE_SIGNALS
 
 PRESET, CRF, ROI_QOFFSET = "superfast", "32", -0.3
 ONE_THREAD_CPUS = 2  # see x264_threads()
@@ -80,7 +81,8 @@ def mux(final, tmp, log, rate: int, samples: np.ndarray) -> int:
            "-movflags", "+faststart", "-f", "mp4", out]
     try:  # run() kills ffmpeg if we are interrupted while it works
         code = subprocess.run(cmd, input=memoryview(np.ascontiguousarray(samples, "<i2")).cast("B"),
-                              stdout=subprocess.DEVNULL, stderr=log, start_new_session=True).returncode
+                              stdout=subprocess.DEVNULL, stderr=log, start_new_session=True,
+                              restore_signals=RESTORE_SIGNALS).returncode
         if code:
             out.unlink(missing_ok=True)
             return code

@@ -25,6 +25,11 @@ PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe (/proc/
 F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)  # Linux; elsewhere the call fails harmlessly
 
 
+# Every ffmpeg we start keeps Python's SIGXFSZ and SIGPIPE ignored (Popen's restore_signals): then a write past
+# the file-size limit fails with EFBIG, which ffmpeg logs and os_error() reads, where the signal's default action
+# killed it with nothing said ("ffmpeg failed: exit status -25"; tests/test_hardening.py).
+RESTORE_SIGNALS = False
+
 # What ffmpeg reports in the system's own words (av_strerror is strerror) when the file system fails it: then
 # the user reads that reason and the file, as for any other write, not ffmpeg's account of its muxer.
 FILE_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM,
