@@ -172,20 +172,10 @@ def render_small(name, out, threads=None):
 
 @pytest.fixture(scope="session")
 def preset_renders(tmp_path_factory):
-    from render.draw import split
     from render.config.scene import list_presets
     start_afresh()  # a session fixture is built before the module's own fixtures: the same history on any worker
     out = tmp_path_factory.mktemp("presets")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(split, "cost", fixed_cost)
-        return {p.stem: render_small(p.stem, out) for p in list_presets()}
-
-
-def fixed_cost(run: dict) -> float:
-    """A comparison's labels show each variant's measured cost, which no two runs share: a fixed one in tests
-    that compare the bytes of two renders (monkeypatched over render/draw/split.py's cost)."""
-    from render.draw import split
-    return 1e-3 * split.integrators.METHOD[run["integrator"]["method"]].order
+    return {p.stem: render_small(p.stem, out) for p in list_presets()}
 
 
 def ocr_line(img, whitelist: str, pattern: str) -> float | None:

@@ -49,8 +49,6 @@ def child(preset: str, npz: Path, out: Path) -> int:
 
     np.argsort = distinct_stable
     import conftest
-    from render.draw import split
-    split.cost = conftest.fixed_cost  # as the preset_renders fixture does
     frames = conftest.render_small(preset, out)[2]
     np.savez(npz, **frames)
     print(" ".join(f"{k}={int(features.get(k, False))}" for k in ("AVX2", "FMA3", "AVX512F")))

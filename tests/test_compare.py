@@ -94,6 +94,7 @@ def test_labels_show_the_variant_the_cost_and_the_live_error(precision):
     assert 0.5 < v32["divergence_s"] < 8 and v32["max_error"] > 0.1 and v32["tolerance"] == 1e-3
     for v, prec in ((v32, "f32"), (v64, "f64")):
         assert v["integrator"]["precision"] == prec and v["cost_s_per_simulated_s"] > 0
+        assert v["force_evaluations_per_simulated_s"] == 4 * v["integrator"]["substeps"] * meta["fps"]
         assert v["faithfulness"]["shadow"]["precision"] == "f64" and v["timings_s"]["simulate"] > 0
     assert v32["faithfulness"]["median_until_s"] < v64["faithfulness"]["median_until_s"]
     assert meta["integrator"] == v64["integrator"] and meta["faithfulness"] == v64["faithfulness"]
@@ -105,9 +106,7 @@ def methods_source():
     # overridden as `pendulum compare compare_methods --set ...` is: the scene is named for its folder
     scene = output_name(load("compare_methods", ["video.width=256", "video.height=144", "video.fps=10",
                                                   "video.duration=2"]), True)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(split, "cost", lambda run: 0.125)  # measured times differ run to run: fixed for bytes
-        yield lambda threads: pipeline.open_source(scene, threads=threads)
+    yield lambda threads: pipeline.open_source(scene, threads=threads)
 
 
 def digest(src) -> str:
@@ -115,6 +114,17 @@ def digest(src) -> str:
     for _ in range(src.frames):
         h.update(src.next_frame().tobytes())
     return h.hexdigest()
+
+
+def test_two_runs_of_a_comparison_draw_the_same_frames_labels_and_all():
+    """At 640x360 every label line is drawn, the cost too: two runs give the same bytes. The cost was the wall time
+    each variant's simulation took, measured anew in every run, so no two runs of one comparison matched."""
+    scene = output_name(load("compare_methods", ["video.width=640", "video.height=360", "video.fps=10",
+                                                  "video.duration=1"]), True)
+    first = pipeline.open_source(scene)
+    text = [t for t, *_ in first.labels(0)]
+    assert any(t.startswith("cost 4000 force evaluations") for t in text), text  # drawn whole, not cut
+    assert digest(first) == digest(pipeline.open_source(scene))
 
 
 def test_the_split_screen_is_a_frame_source_deterministic_at_any_thread_count(methods_source):
@@ -127,7 +137,8 @@ def test_the_split_screen_is_a_frame_source_deterministic_at_any_thread_count(me
     assert digest(methods_source(2)) == first
     lines = [text for text, _ in one.label_lines(0, 19)]
     # the step once, as run: the variant names it, so the integrator's line says only the precision
-    assert lines[:3] == ["method = symplectic_euler, dt = 2.5e-4 s", "f64", "cost 125 ms per simulated s"]
+    assert lines[:3] == ["method = symplectic_euler, dt = 2.5e-4 s", "f64",
+                         "cost 4000 force evaluations per simulated s"]  # 1 per step of 0.25 ms: equal cost
     assert one.runs[0]["integrator"]["dt"] == 2.5e-4  # as run: whole steps fit a frame at 10 fps
     assert re.fullmatch(r"Δθ \S+ rad(, parted at \d+\.\d\d s)?", lines[3]), lines
     assert re.fullmatch(r"faithful to (the end|\d+\.\d\d s)", lines[4]), lines

@@ -10,9 +10,8 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from conftest import PICKS, fixed_cost, render_small
+from conftest import PICKS, render_small
 from render.config.scene import list_presets
-from render.draw import split
 
 
 GOLDEN = Path(__file__).parent / "golden"
@@ -105,7 +104,6 @@ def test_every_preset_is_the_same_bytes_at_1_and_8_threads_as_on_all_cpus(preset
     canvas.BANDED_WORK): on 8 threads both go to the pool here, so that the threads are compared with one."""
     from render.draw import canvas
     from render.physics import runtime
-    monkeypatch.setattr(split, "cost", fixed_cost)
     _, meta, frames = preset_renders[name]
     for threads in (1, 8):
         if threads == 8:

@@ -1,5 +1,5 @@
 """A comparison's frames: its variants side by side (2) or 2x2 (3 or 4) under one shared clock, each panel
-drawn by the render's own canvas at the panel's size, labelled with the variant, its measured cost, its error
+drawn by the render's own canvas at the panel's size, labelled with the variant, its cost, its error
 against the finest and until when its own certificate holds it faithful.
 
 Two passes, because Taichi holds one precision per process (render/physics/runtime.py) and variants may differ in it:
@@ -20,12 +20,13 @@ faithful, and its HUD clock turns amber and red at that certificate's times. A p
 largest deviation of any of its pendulums from the same pendulum of the finest variant (System.deviation:
 rad on any angle, the difference wrapped to (−π, π] first, since angles a turn apart draw the same picture;
 springs, a fraction of the total rest length), shown live; it parts from the finest at the first frame where
-that error exceeds its integrator.tolerance. The cost is the wall time its simulation took per simulated
-second in pass 1, when nothing else of the render runs. The step is said once, as run (System.h, which fits
+that error exceeds its integrator.tolerance. The cost is its force evaluations per simulated second (a pendulum's),
+as run; the wall time its simulation took per simulated second in pass 1, when nothing else of the render runs, is
+in the metadata (cost_s_per_simulated_s), not in the frames. The step is said once, as run (System.h, which fits
 whole steps into a frame, not the dt asked for).
 
 Frames are deterministic at any thread count (recorded states, the canvas's order-free compositing, serial
-text) except the cost figures, which are measured; tests that compare bytes replace `cost`.
+text).
 """
 from __future__ import annotations
 
@@ -46,9 +47,12 @@ GAP = 2  # px of grey at least between panels
 DIVIDER = 72  # its grey level
 
 
-def cost(run: dict) -> float:
-    """Wall seconds of simulation per simulated second, as measured in pass 1 (pipeline.record)."""
-    return run["cost"]
+def cost(run: dict, fps: int) -> int:
+    """Force evaluations per simulated second of each pendulum, as run: what a panel's label says it costs. The
+    wall time its simulation took (metadata's cost_s_per_simulated_s) differs from run to run, and drawn into the
+    frames it made them differ too."""
+    integ = run["integrator"]
+    return integrators.METHOD[integ["method"]].evals * integ["substeps"] * fps
 
 
 def clock_face(height: int) -> tuple[str, int]:
@@ -140,7 +144,7 @@ class SplitScreen:
         self.errors = [sim.deviation(turned(run["q"] - ref_q), 0.0).max(-1) if self.angles else
                        sim.deviation(run["q"], ref_q).max(-1) for run in self.runs]
         self.parted = [self.divergence(i) for i in range(len(self.runs))]
-        self.costs = [cost(run) for run in self.runs]
+        self.costs = [cost(run, scene.video.fps) for run in self.runs]
         self.delta = "Δθ" if self.angles else "Δx/L"  # what the error measures: rad, or of the total length
         self.font = Font()
         self.size = label_face(self.rects[0][3])[0]
@@ -191,7 +195,7 @@ class SplitScreen:
                 for key in INTEGRATOR if key not in dict(self.scene.compare)]
         hud = self.panels[i].canvas.hud
         lines = [(variant, COLOURS["title"]), (", ".join(rest), COLOURS["detail"]),
-                 (f"cost {1e3 * self.costs[i]:.3g} ms per simulated s", COLOURS["detail"])]
+                 (f"cost {self.costs[i]} force evaluations per simulated s", COLOURS["detail"])]
         parted = self.parted[i]
         if i == self.ref:
             lines.append((f"finest: the reference for {self.delta}", COLOURS["finest"]))
@@ -264,7 +268,8 @@ class SplitScreen:
             "quality": run["chosen"],
             "faithfulness": run["cert"].to_dict(),
             "timings_s": {k: round(val, 4) for k, val in run["timings"].items()},
-            "cost_s_per_simulated_s": round(self.costs[i], 6),
+            "cost_s_per_simulated_s": round(run["cost"], 6),
+            "force_evaluations_per_simulated_s": self.costs[i],
             "divergence_s": self.parted[i],
             "tolerance": run["scene"].integrator.tolerance,
             "max_error": float(self.errors[i].max()),
