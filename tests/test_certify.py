@@ -201,6 +201,19 @@ def test_each_level_is_met_by_the_cheapest_stable_setting_found(level):
     assert all(t["median_until_s"] < PROMISED[level] * 8.0 for t in cheaper)
 
 
+def test_a_pilot_reports_no_faithful_time_beyond_what_it_ran():
+    """A draft pilot runs to half the video (the target) and a little more: pendulums still faithful there were
+    recorded as faithful to the end, so the chosen setting's pilot said 2.0 s of 2 where the render's own
+    certificate found 1.48 s. Now a pilot's median is at most how far it ran, pilot_until_s."""
+    scene = load("rigid_chaos", ["video.duration=2", "video.fps=60", "pendulums.count=20"], quality="draft")
+    chosen_scene, report = quality.choose(scene)
+    tried = report["pilots"]["tried"]
+    assert all(t["median_until_s"] <= t["pilot_until_s"] for t in tried), tried
+    assert all(1.0 < t["pilot_until_s"] < 2.0 for t in tried), tried  # half of 2 s, and the frames to know it
+    chosen = [t for t in tried if all(t[k] == report["chosen"][k] for k in ("method", "dt", "precision"))][-1]
+    assert chosen["median_until_s"] <= certify.certify(chosen_scene).median_until_s + 1 / 60, (chosen, report)
+
+
 def test_an_unreachable_level_says_so_and_renders_the_most_faithful(capsys):
     scene = load("rigid_chaos", ["video.duration=20", "video.fps=10", "pendulums.count=16"], quality="high")
     chosen_scene, report = quality.choose(scene)

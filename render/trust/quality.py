@@ -76,7 +76,7 @@ def choose(scene, arch: str = "cpu", threads=None):
 
     def meets(s: dict) -> bool:
         median = pilot.median_until(s, need)
-        tried.append({**s, "cost": cost(s, fps), "median_until_s": median})
+        tried.append({**s, "cost": cost(s, fps), "median_until_s": median, "pilot_until_s": pilot.horizon})
         return median >= need
 
     for prec in ("f64", "f32"):  # one Taichi runtime per precision: all f64 pilots first
@@ -120,11 +120,15 @@ class Pilot:
         ref = _with(scene, setting("rk4", ref_dt, "f64"))
         # As far as the target needs: a pilot's outcome is known there.
         self.frames = min(scene.frames, math.ceil(need * scene.video.fps) + 2)
+        # How far a pilot looks: a pendulum still faithful there is faithful "until" here, no further (the
+        # certificate's whole duration where the pilot runs to the end), so no report claims what no run saw.
+        self.horizon = scene.video.duration if self.frames == scene.frames else (self.frames - 1) / scene.video.fps
         self.ref, _ = certify.trajectory(ref, self.indices, arch, threads, self.frames)
         self.runs = {}
 
     def median_until(self, s: dict, need: float) -> float:
-        """The median pendulum's faithful time under setting s, run only as far as it takes to know."""
+        """The median pendulum's faithful time under setting s, run only as far as it takes to know: at most
+        self.horizon, which the target never exceeds."""
         scene = _with(self.scene, s)
         key = (s["method"], s["precision"])
         if key not in self.runs or not self.runs[key].current:  # one compile per method and runtime
@@ -135,16 +139,16 @@ class Pilot:
         fps, tol = scene.video.fps, scene.integrator.tolerance
         substeps = math.ceil(1.0 / (fps * s["dt"]) - 1e-9)
         h = 1.0 / (fps * substeps)
-        until = np.full(len(self.indices), scene.video.duration)
+        until = np.full(len(self.indices), self.horizon)
         half = len(self.indices) // 2
         # No watchdog: a blow-up is an outcome here (NaN is broken), not an error.
         for f in run.frames(self.frames, substeps=substeps, h=h, energy=False, watch=False):
             if not f:
                 continue  # the start, where every setting agrees
             err = certify.MARGIN * sim.deviation(sim.q.to_numpy(), self.ref[f]) / tol
-            fresh = (until >= scene.video.duration) & ~(err <= 1.0)  # NaN counts as broken
+            fresh = (until >= self.horizon) & ~(err <= 1.0)  # NaN counts as broken
             until[fresh] = (f - 1) / fps
-            if np.sum(until < scene.video.duration) > half and f / fps <= need:
+            if np.sum(until < self.horizon) > half and f / fps <= need:
                 break  # the median has broken before the target: no need to run on
         return float(np.median(until))
 
