@@ -45,6 +45,13 @@ def test_no_display_exits_2_with_one_line(extra):
     assert "Traceback" not in r.stderr and r.stdout == ""
 
 
+def test_no_display_is_one_line_even_for_a_run_long_enough_to_announce(tmp_path):
+    """rigid_chaos is estimated over a minute at the built-in rates (no OUT/bench/rates.json): render says so
+    first; show without a display says only that it has none."""
+    r = run_cli("show", "rigid_chaos", "--out", tmp_path / "out", env=env_without_display(), timeout=60)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1 and "no display" in r.stderr, r.stderr
+
+
 def test_bad_preset_is_still_bad_input():
     r = run_cli("show", "no_such_preset", env=env_without_display(), timeout=60)
     assert r.returncode == 2 and len(r.stderr.splitlines()) == 1 and "no_such_preset" in r.stderr

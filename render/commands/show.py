@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import shlex
+import sys
 import time
 from pathlib import Path
 
@@ -118,9 +119,11 @@ def run(args) -> int:
     check_out_folder(scene, args.out, files=())
     # what `render` refuses, `show` refuses too: it simulates and certifies the same (a comparison records its
     # variants whole before the window opens), so memory and time are those of a render
-    budget.check_run([scene], args.out)
+    estimate = budget.check_run([scene], args.out, say=False)
     suggest = render_command(args)
-    probe = check_display(suggest)  # before any compiling: a missing display fails at once
+    probe = check_display(suggest)  # before any compiling: a missing display fails at once, its one line alone
+    if estimate:
+        print(estimate, file=sys.stderr, flush=True)
     try:
         if scene.fractal:  # a map to explore: click, zoom, back (render/commands/explore.py)
             from .explore import explore

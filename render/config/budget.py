@@ -84,9 +84,10 @@ def check(scene, system, out: Path | None, simulate: bool = False):
     return est
 
 
-def check_run(scenes: list, out: Path | None, simulate: bool = False) -> float:
-    """check() every scene, then hold their sum to the run's limit (the largest of theirs); print the estimate
-    on stderr when it is over ANNOUNCE_S. Returns the estimated seconds."""
+def check_run(scenes: list, out: Path | None, simulate: bool = False, say: bool = True) -> str | None:
+    """check() every scene, then hold their sum to the run's limit (the largest of theirs). Returns the estimate's
+    line when it is over ANNOUNCE_S (else None), said on stderr here unless `say` is False: then by the caller,
+    once nothing else can refuse the run (`show`, after its display)."""
     ests = [check(s, _system(s), out, simulate) for s in scenes]
     total, limit = sum(e.total for e in ests), max(limit_s(s) for s in scenes)
     if len(scenes) > 1 and total > limit:
@@ -94,11 +95,13 @@ def check_run(scenes: list, out: Path | None, simulate: bool = False) -> float:
         raise SceneError(f"{len(scenes)} renders ({names}): estimated {duration(total)} together "
                          f"({breakdown(ests)}), over the run-time budget of {duration(limit)}; render fewer at once, "
                          f"or {raise_by(total)}")
-    if total > ANNOUNCE_S:
-        what = scenes[0].name if len(scenes) == 1 else f"{len(scenes)} renders"
-        print(f"pendulum: {what}: estimated {duration(total)} ({breakdown(ests)}), within the budget of "
-              f"{duration(limit)}", file=sys.stderr, flush=True)
-    return total
+    if total <= ANNOUNCE_S:
+        return None
+    what = scenes[0].name if len(scenes) == 1 else f"{len(scenes)} renders"
+    line = f"pendulum: {what}: estimated {duration(total)} ({breakdown(ests)}), within the budget of {duration(limit)}"
+    if say:
+        print(line, file=sys.stderr, flush=True)
+    return line
 
 
 @functools.lru_cache(maxsize=64)
