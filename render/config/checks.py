@@ -35,7 +35,8 @@ class Checker:
                 owners = [n for n in SYSTEMS if prefix == "pendulums." and k in registry.get(n).preset_keys()]
                 if owners:
                     self.fail(key, f"is not a key of this system (it belongs to system {' and '.join(owners)})")
-                self.fail(show_key(key), "unknown key" + hint(k, list(schema), prefix))
+                near = hint(k, list(schema), prefix) or elsewhere(k, schema, prefix)
+                self.fail(show_key(key), "unknown key" + near)
             if isinstance(schema[k], dict):
                 if not isinstance(val, dict):
                     self.fail(key, f"must be a table, got {tname(val)}")
@@ -130,6 +131,22 @@ def describe_range(lo: float, hi: float, lo_open: bool) -> str:
 def hint(word: str, options: list[str], prefix: str = "") -> str:
     close = difflib.get_close_matches(word, options, n=1)
     return f" (did you mean '{prefix}{close[0]}'?)" if close else ""
+
+
+def elsewhere(word: str, schema: dict, prefix: str) -> str:
+    """A hint for a key close to none of its own section's: a key of another system's pendulums (`stiffnes` in
+    a rigid preset), or of a section below this one (`count` at the top, for pendulums.count)."""
+    owners = {}
+    if prefix == "pendulums.":
+        for name in SYSTEMS:
+            for key in registry.get(name).preset_keys():
+                owners.setdefault(key, []).append(name)
+    close = difflib.get_close_matches(word, list(owners), n=1)
+    if close:
+        return f" (did you mean '{prefix}{close[0]}', a key of system {' and '.join(owners[close[0]])}?)"
+    below = {key: f"{prefix}{sec}.{key}" for sec, sub in schema.items() if isinstance(sub, dict) for key in sub}
+    close = difflib.get_close_matches(word, list(below), n=1)
+    return f" (did you mean '{below[close[0]]}'?)" if close else ""
 
 
 def clip(text: str, limit: int = 80) -> str:
