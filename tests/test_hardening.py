@@ -232,6 +232,51 @@ def test_files_written_together_appear_together_or_not_at_all(tmp_path):
     assert (tmp_path / "alone.txt").read_bytes() == b"x"
 
 
+def test_an_interrupt_while_the_gifs_frames_are_set_up_leaves_nothing(tmp_path, monkeypatch):
+    """The encoders' temporaries exist from Encoder() on: a Ctrl-C while the GIF's own canvas is built (between
+    them and the frame loop) left them and the new folder, while the CLI said no partial output was left."""
+    from render.config.scene import load
+    from render.video import gif, pipeline
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(gif, "Frames", interrupted)
+    scene = load("classic", ["video.width=64", "video.height=36", "video.duration=0.2", "video.fps=10"])
+    with pytest.raises(KeyboardInterrupt):
+        pipeline.render(scene, tmp_path / "out")
+    assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
+
+
+def test_a_cleanup_that_fails_too_does_not_hide_the_failure(tmp_path, monkeypatch):
+    """A full disk as metadata.json is written, in a folder where the temporaries cannot be removed either: the
+    error reported is the full disk's, not the cleanup's (which named a hidden temporary), and every temporary
+    that can go is tried."""
+    import errno
+    import pathlib
+    from render.config.scene import load
+    from render.video import pipeline
+
+    def full(*a, **k):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    real, tried = pathlib.Path.unlink, []
+
+    def stuck(self, missing_ok=False):
+        if self.name.endswith(".part"):
+            tried.append(self.name)
+            raise PermissionError(errno.EPERM, os.strerror(errno.EPERM), str(self))
+        return real(self, missing_ok=missing_ok)
+
+    monkeypatch.setattr(pipeline, "metadata", full)
+    monkeypatch.setattr(pathlib.Path, "unlink", stuck)
+    scene = load("classic", ["video.width=64", "video.height=36", "video.duration=0.2", "video.fps=10"])
+    with pytest.raises(OSError) as e:
+        pipeline.render(scene, tmp_path)
+    assert e.value.errno == errno.ENOSPC, e.value
+    assert sum(".mp4." in n for n in tried) >= 1 and sum(".gif." in n for n in tried) >= 1, tried  # each tried
+
+
 def test_a_publish_that_fails_halfway_puts_the_earlier_result_back(tmp_path, monkeypatch):
     """atomic.publish_all: the third rename fails after two new files had replaced an earlier run's; those two are
     put back, the new ones are gone, and nothing hidden is left (neither temporaries nor the kept links)."""

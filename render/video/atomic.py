@@ -82,6 +82,13 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def discard(path: Path):
+    """Remove a file of ours while cleaning up after a failure: if that fails too (a folder made unwritable
+    meanwhile), the failure being cleaned up after is still the one reported, and the cleanup goes on."""
+    with contextlib.suppress(OSError):
+        Path(path).unlink(missing_ok=True)
+
+
 def publish(tmp: Path, path: Path):
     """Rename a finished temporary file onto its final path, readable like any other output."""
     try:
@@ -107,17 +114,18 @@ def publish_all(pairs: list[tuple[Path, Path]]):
                     publish(tmp, path)
                 except BaseException:
                     for (_, done), old in zip(pairs[:i], kept):  # put the earlier result back, or none of this one
-                        if old is not None:
-                            os.replace(old, done)
+                        if old is None:
+                            discard(done)
                         else:
-                            done.unlink(missing_ok=True)
+                            with contextlib.suppress(OSError):
+                                os.replace(old, done)
                     for waiting, _ in pairs[i:]:
-                        waiting.unlink(missing_ok=True)
+                        discard(waiting)
                     raise
         finally:
             for old in kept:
                 if old is not None:
-                    old.unlink(missing_ok=True)
+                    discard(old)
 
 
 def _keep(path: Path) -> Path | None:
@@ -129,7 +137,7 @@ def _keep(path: Path) -> Path | None:
         link.unlink()
         os.link(path, link)
     except OSError:
-        link.unlink(missing_ok=True)
+        discard(link)
         return None
     return link
 
@@ -172,7 +180,7 @@ def replacing(path: Path, suffix: str = ".part"):
         else:
             held.append((tmp, Path(path)))
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        discard(tmp)
         raise
 
 
@@ -221,14 +229,14 @@ def _together():
         yield
     except BaseException:
         for tmp, _ in held:
-            tmp.unlink(missing_ok=True)
+            discard(tmp)
         raise
     finally:
         _held.reset(token)
     for _, path in held:  # the one rename that fails in a folder we could write: onto a folder
         if path.is_dir() and not path.is_symlink():
             for tmp, _ in held:
-                tmp.unlink(missing_ok=True)
+                discard(tmp)
             raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
     publish_all(held)  # together or not at all, the files they replace kept until then
 

@@ -22,7 +22,7 @@ import numpy as np
 from . import gif, mp4, palette
 from . import pipe
 from .pipe import Pipe, ends, os_error
-from .atomic import publish_all, temp_beside
+from .atomic import discard, publish_all, temp_beside
 from ..errors import EncodeError
 
 class _Still:
@@ -76,7 +76,7 @@ class Encoder:
                                             stdout=subprocess.PIPE if own else subprocess.DEVNULL,
                                             restore_signals=pipe.RESTORE_SIGNALS)
                 except BaseException:  # (start_new_session: Ctrl-C reaches us, and we clean up)
-                    tmp.unlink(missing_ok=True)
+                    discard(tmp)
                     log.close()
                     raise
                 t = Pipe(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif" else None,
@@ -204,10 +204,10 @@ class Encoder:
             except queue.Full:
                 pass
             t.thread.join(timeout=5)
-            t.tmp.unlink(missing_ok=True)
+            discard(t.tmp)
             t.log.close()
         for s in self.stills:
-            s.tmp.unlink(missing_ok=True)
+            discard(s.tmp)
         self.targets, self.stills = [], []
 
     def _mux(self, t: Pipe, rate: int, samples: np.ndarray):

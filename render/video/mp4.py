@@ -26,7 +26,7 @@ import subprocess
 import imageio_ffmpeg
 import numpy as np
 
-from .atomic import temp_beside
+from .atomic import discard, temp_beside
 from .pipe import RESTORE_SIGNALS
 
 PRESET, CRF, ROI_QOFFSET = "superfast", "32", -0.3
@@ -84,10 +84,10 @@ def mux(final, tmp, log, rate: int, samples: np.ndarray) -> int:
                               stdout=subprocess.DEVNULL, stderr=log, start_new_session=True,
                               restore_signals=RESTORE_SIGNALS).returncode
         if code:
-            out.unlink(missing_ok=True)
+            discard(out)
             return code
     except BaseException:
-        out.unlink(missing_ok=True)
+        discard(out)
         raise
     os.replace(out, tmp)  # atomic: at every moment exactly one temporary is ours to remove
     return 0

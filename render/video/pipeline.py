@@ -14,7 +14,7 @@ from . import audio
 from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
-from .atomic import digest, naming, replacing, signals_held, temp_beside
+from .atomic import digest, discard, naming, replacing, signals_held, temp_beside
 from .files import read_regular
 from .metadata import integrator_meta, metadata, run_meta
 
@@ -166,7 +166,7 @@ def map_data(src, out_dir: Path) -> list[tuple[Path, Path]]:
         with naming(path):
             np.savez_compressed(tmp, **data.arrays(src.scene, src.canvas))
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        discard(tmp)
         raise
     return [(tmp, path)]
 
@@ -201,15 +201,15 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
         voices = audio.Voices(src.sim, scene.video.fps, scene.frames)
     with output_dir(scene.out_dir(out_root)) as out_dir:
         enc = Encoder(out_dir, scene.name, scene.video, scene.frames, planar=True)
-        small = Frames(src, scene.video, timings) if "gif" in scene.video.formats else None  # the GIF's own
-        # A GIF alone with a canvas of its own needs no frame of the video's size: 720p frames drawn for nothing
-        # were half of a GIF-only rigid_chaos render (28.4 s, 14.8 s without them).
-        drawn = set(scene.video.formats) != {"gif"} or not small.alone or frame_hook is not None
-        # One frame drawn over each time where nothing keeps it past write(): a new zeroed 720p array took 0.5 ms
-        # a frame (allocator and page faults; rigid_chaos, cProfile), refilling one 0.1 ms.
-        reuse, buf = not enc.queues_frames and frame_hook is None, None
         pending = []  # (temporary, final) of the files beside the videos
-        try:
+        try:  # from here on a failure or an interrupt removes the encoders' temporaries (enc.abort())
+            small = Frames(src, scene.video, timings) if "gif" in scene.video.formats else None  # the GIF's own
+            # A GIF alone with a canvas of its own needs no frame of the video's size: 720p frames drawn for
+            # nothing were half of a GIF-only rigid_chaos render (28.4 s, 14.8 s without them).
+            drawn = set(scene.video.formats) != {"gif"} or not small.alone or frame_hook is not None
+            # One frame drawn over each time where nothing keeps it past write(): a new zeroed 720p array took
+            # 0.5 ms a frame (allocator and page faults; rigid_chaos, cProfile), refilling one 0.1 ms.
+            reuse, buf = not enc.queues_frames and frame_hook is None, None
             with progress_bar(scene.frames, scene.name, progress) as bar:
                 for f in range(scene.frames):
                     # the frame, or None where nothing needs it; a new array where the encoder shares it
@@ -258,7 +258,7 @@ def render(scene, out_root: Path, arch: str = "cpu", progress: bool = False, thr
         except BaseException:
             enc.abort()
             for tmp, _ in pending:
-                tmp.unlink(missing_ok=True)
+                discard(tmp)
             raise
     return meta
 
