@@ -187,8 +187,8 @@ def test_watchdog_names_energy_drift(tmp_path):
     assert not any(tmp_path.rglob("*"))
 
 
-@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupted_render_leaves_no_files(tmp_path, sig, code):
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143), (signal.SIGHUP, 129)])
+def test_interrupted_render_leaves_no_files(tmp_path, sig, code):  # SIGHUP: its terminal closed
     proc = subprocess.Popen([sys.executable, "-m", "render", "render", "rigid_chaos", "--out", str(tmp_path),
                              "--no-progress", "--set", "video.width=320", "--set", "video.height=180",
                              # a minute of video: however fast the machine, the signal comes while it encodes

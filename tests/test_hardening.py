@@ -392,6 +392,50 @@ def test_a_render_removes_the_files_of_an_earlier_render_it_does_not_write_again
     assert render("gif") == ["metadata.json", "x.gif", "x.png", "x.webm"]
 
 
+def group_alive(pgid: int) -> list[int]:
+    """The processes of a process group still running (zombies aside)."""
+    alive = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            alive.append(int(stat.parent.name))
+    return alive
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_batch_on_two_workers_stopped_mid_render_exits_and_leaves_nothing(tmp_path, sig, code):
+    """Ctrl-C (or SIGTERM) to the whole group, as a terminal sends it, while the workers render: the batch exits
+    with its code, no worker lives on and no temporary is left. A worker stopped inside a render had gone on
+    waiting for another task, and the batch waited for it forever after saying it was interrupted."""
+    proc = subprocess.Popen([sys.executable, "-m", "render", "batch", "rigid_chaos", "classic", "--jobs", "2",
+                             "--out", str(tmp_path / "out"), "--no-progress", "--set", "video.width=640",
+                             "--set", "video.height=360", "--set", "video.duration=120"],
+                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    deadline = time.time() + 180
+    while len(list((tmp_path / "out").rglob(".*.part"))) < 2 and time.time() < deadline:  # encoding
+        time.sleep(0.05)
+    try:
+        assert len(list((tmp_path / "out").rglob(".*.part"))) >= 2, "no render started encoding"
+        os.killpg(proc.pid, sig)
+        _, err = proc.communicate(timeout=90)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == code, err
+    deadline = time.time() + 10
+    while group_alive(proc.pid) and time.time() < deadline:  # the workers were told to go; give them a moment
+        time.sleep(0.1)
+    left = group_alive(proc.pid)
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f"processes left behind: {left}"
+    assert not list((tmp_path / "out").rglob("*.part")), list((tmp_path / "out").rglob("*"))
+
+
 def test_a_batch_output_corrupted_in_place_is_rendered_again(tmp_path):
     (tmp_path / "p.toml").write_text(GOOD.format(name="p"))
     first = run_user("batch", "p.toml", "--out", "out", "--jobs", "1", "--no-progress", cwd=tmp_path)

@@ -29,6 +29,7 @@ from ..video.tiled import close, connect, env_address, quiet, scheduler_address
 from ..video.version import __version__
 
 _RENDER_LOCK = threading.Lock()  # one Taichi runtime per process: Dask threads in one worker take turns
+STOP_S = 30.0  # how long a stopped worker may take to remove its partial files before it is killed
 
 
 def add_parser(sub):
@@ -87,8 +88,26 @@ def render_one(scene, out_root: str, arch: str = "cpu", threads: int | None = No
 def _worker_init():
     # The parent handles Ctrl-C and stops workers with SIGTERM; SystemExit lets the pipeline remove partials.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)  # a closed terminal reaches the parent too, which stops us
+    signal.signal(signal.SIGTERM, _stop)
     os.dup2(2, 1)  # Taichi's start-up line would interleave with the parent's summary table on stdout
+
+
+def _stop(signum, frame):
+    """SIGTERM in a worker: once. The group's and the parent's both come, and a second SystemExit would cut the
+    render's cleanup short, leaving its partial files."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    sys.exit(143)
+
+
+def _render_in_worker(*args):
+    """render_one in a pool's worker: stopped by SIGTERM, it exits once the render has removed its partial
+    files. The pool's worker loop catches the SystemExit of a task and waits for the next one, which never
+    comes: the parent then waited for that worker forever."""
+    try:
+        return render_one(*args)
+    except SystemExit:
+        os._exit(143)
 
 
 def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
@@ -101,7 +120,7 @@ def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn"), initializer=_worker_init)
     try:
-        futs = {pool.submit(render_one, s, str(out_root), arch, threads, digest): s for s in scenes}
+        futs = {pool.submit(_render_in_worker, s, str(out_root), arch, threads, digest): s for s in scenes}
         for fut in as_completed(futs):
             try:
                 yield fut.result()
@@ -109,11 +128,17 @@ def run_local(scenes, out_root, jobs, arch, threads, digest, progress):
                 yield {"preset": futs[fut].name, "status": "failed",
                        "error": f"worker died: {str(e) or type(e).__name__}"}
     except BaseException:
-        for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        procs = list((getattr(pool, "_processes", None) or {}).values())
+        for proc in procs:
             proc.terminate()  # no public API stops running tasks; SIGTERM lets each clean up its partials
+        for proc in procs:
+            proc.join(STOP_S)
+            if proc.is_alive():  # stuck: its temporaries are swept by the next write into its folder
+                proc.kill()
+                proc.join()
+        pool.shutdown(wait=False, cancel_futures=True)
         raise
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    pool.shutdown(wait=True)
 
 
 def run_dask(scenes, out_root, address, arch, threads, digest):

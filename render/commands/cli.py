@@ -38,7 +38,11 @@ COMMANDS = {
 
 
 class Terminated(BaseException):
-    """SIGTERM, turned into an exception so every `finally`/cleanup runs."""
+    """SIGTERM (or SIGHUP: the terminal closed), turned into an exception so every `finally`/cleanup runs."""
+
+    def __init__(self, signum: int = signal.SIGTERM):
+        super().__init__(signum)
+        self.signum = signum
 
 
 class Parser(argparse.ArgumentParser):
@@ -172,6 +176,7 @@ def cmd_presets(args) -> int:
 
 # Distributions whose import name differs: what `pip install` takes for a module found missing.
 DISTRIBUTIONS = {"dask": "dask[distributed]", "distributed": "dask[distributed]", "imageio_ffmpeg": "imageio-ffmpeg"}
+STOPS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)  # what stops a run, its cleanup done (on_signals)
 RESEND_S = 0.005  # a signal lost in a finalizer comes again this much later: the finalizer has returned by then
 
 
@@ -181,9 +186,19 @@ def on_signals():
     installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. A signal that lands in
     a finalizer (a __del__ of llvmlite's, say) raises there, where Python only prints the exception and goes on
     (a SIGTERM was lost so): the signal is sent again from a thread, so its handler runs once the finalizer has
-    returned, and nothing is printed."""
+    returned, and nothing is printed. Once one has come, the others are held off: a second Ctrl-C or SIGTERM
+    (a batch's workers get both the group's and the parent's) would cut the cleanup short and leave partial files."""
+    def stopping():
+        for s in STOPS:
+            signal.signal(s, signal.SIG_IGN)
+
     def on_term(signum, frame):
-        raise Terminated()
+        stopping()
+        raise Terminated(signum)
+
+    def on_int(signum, frame):
+        stopping()
+        raise KeyboardInterrupt
 
     def resend(signum):
         time.sleep(RESEND_S)
@@ -192,12 +207,18 @@ def on_signals():
     def unraisable(info, passed_on=sys.unraisablehook):
         for kind, signum in ((Terminated, signal.SIGTERM), (KeyboardInterrupt, signal.SIGINT)):
             if isinstance(info.exc_value, kind):  # raised here, the handler would run inside this hook; and
+                signum = getattr(info.exc_value, "signum", signum)
+                listen()  # the resent signal must reach a handler, not the ignoring that stopping() set
                 _thread.start_new_thread(resend, (signum,))  # Thread.start() waits for its thread, so it would too
                 return
         passed_on(info)
 
-    signal.signal(signal.SIGTERM, on_term)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    def listen():
+        signal.signal(signal.SIGTERM, on_term)
+        signal.signal(signal.SIGHUP, on_term)
+        signal.signal(signal.SIGINT, on_int)
+
+    listen()
     sys.unraisablehook = unraisable
 
 
@@ -219,9 +240,10 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # e.g. `pendulum presets | head`
         sys.stdout = open(os.devnull, "w")
         return 0
-    except Terminated:
-        print("pendulum: terminated; no partial output was left", file=sys.stderr)
-        return 143
+    except Terminated as e:
+        what = "hung up" if e.signum == signal.SIGHUP else "terminated"
+        print(f"pendulum: {what}; no partial output was left", file=sys.stderr)
+        return 128 + e.signum
     except OSError as e:  # the file system while running: a full disk, a vanished folder, permissions
         where = f": {e.filename}" if e.filename else ""
         return fail(1, "failed", f"{e.strerror or e}{where}", debug)

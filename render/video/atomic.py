@@ -144,13 +144,13 @@ def _keep(path: Path) -> Path | None:
 
 @contextmanager
 def signals_held():
-    """SIGINT and SIGTERM arriving within the block are delivered when it ends, so that a run of renames is
+    """SIGINT, SIGTERM and SIGHUP arriving within the block are delivered when it ends, so that a run of renames is
     never cut in two. Only the main thread can set handlers: elsewhere the block runs as it is."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     caught: list[int] = []
-    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
     for s in before:
         signal.signal(s, lambda sig, frame: caught.append(sig))
     try:

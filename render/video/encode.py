@@ -54,14 +54,16 @@ class Encoder:
         self.stills: list[_Still] = []
         self.size = (video.width, video.height)
         exe = imageio_ffmpeg.get_ffmpeg_exe()
+        loose = None  # a format's temporary, ffmpeg and log until self.targets holds them, where abort() sees them
         try:
             for fmt in formats or video.formats:
                 final = out_dir / f"{name}.{fmt}"
                 if fmt == "png":
                     self.stills.append(_Still(final))
                     continue
-                tmp = temp_beside(final, suffix=".part")
-                log = tempfile.TemporaryFile()
+                loose = [temp_beside(final, suffix=".part"), None, None]
+                tmp = loose[0]
+                log = loose[2] = tempfile.TemporaryFile()
                 rate, (w, h) = (gif.rate(video), gif.size(video)) if fmt == "gif" else (video.fps, self.size)
                 planar = fmt == "mp4" and self.yuv is not None
                 # a GIF's ffmpeg gives its palette (render/video/palette.py), a rainbow's writes it
@@ -71,21 +73,26 @@ class Encoder:
                 cmd = [exe, "-nostdin", "-y", "-loglevel", "error", "-f", "rawvideo",
                        "-pix_fmt", "yuv420p" if planar else "rgb24",
                        "-s", f"{w}x{h}", "-r", str(rate), "-i", "-", "-an", *out]
-                try:
-                    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=log, start_new_session=True,
-                                            stdout=subprocess.PIPE if own else subprocess.DEVNULL,
-                                            restore_signals=pipe.RESTORE_SIGNALS)
-                except BaseException:  # (start_new_session: Ctrl-C reaches us, and we clean up)
-                    discard(tmp)
-                    log.close()
-                    raise
+                # start_new_session: Ctrl-C reaches us, not ffmpeg, and we clean up
+                proc = loose[1] = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=log, start_new_session=True,
+                                                   stdout=subprocess.PIPE if own else subprocess.DEVNULL,
+                                                   restore_signals=pipe.RESTORE_SIGNALS)
                 t = Pipe(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif" else None,
-                            gif.size(video) if fmt == "gif" else None, planar)
+                         gif.size(video) if fmt == "gif" else None, planar)
                 if own:
                     t.kept, t.step, t.rate = [], palette.palette_step(video), rate
                     t.last_counted = (sum(t.repeats) - 1) // t.step * t.step
                 self.targets.append(t)
+                loose = None
         except BaseException:
+            if loose is not None:  # stopped between making them and handing them on
+                tmp, proc, log = loose
+                if proc is not None:
+                    proc.kill()
+                    proc.wait()
+                if log is not None:
+                    log.close()
+                discard(tmp)
             self.abort()
             raise
 
