@@ -248,6 +248,41 @@ def test_an_interrupt_while_the_gifs_frames_are_set_up_leaves_nothing(tmp_path, 
     assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
 
 
+def test_an_interrupt_while_the_track_is_muxed_stops_the_mux_and_leaves_nothing(tmp_path, monkeypatch):
+    """Ctrl-C as the audio track is muxed (its ffmpeg on a thread, in a session of its own): the mux's ffmpeg
+    went on after we had exited, writing a hidden MP4 nobody would remove. Here the mux's ffmpeg would sleep a
+    minute; it is killed, the render stops at once and leaves nothing."""
+    import signal
+    import imageio_ffmpeg
+    from render.config.scene import load
+    from render.video import mp4, pipeline
+
+    real_exe = imageio_ffmpeg.get_ffmpeg_exe()
+    fake = tmp_path / "ffmpeg"
+    fake.write_text(f'#!/bin/sh\ncase "$*" in *" -c:a "*) exec sleep 60;; esac\nexec "{real_exe}" "$@"\n')
+    fake.chmod(0o755)
+    monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", lambda: str(fake))
+    real_mux, procs = mp4.mux, []
+
+    def mux(final, tmp, log, rate, samples, running=None):
+        class Started(list):
+            def append(self, proc):
+                if running is not None:
+                    running.append(proc)
+                procs.append(proc)
+                os.kill(os.getpid(), signal.SIGINT)  # the main thread is waiting for the mux, or mapping the GIF
+        return real_mux(final, tmp, log, rate, samples, Started())
+
+    monkeypatch.setattr(mp4, "mux", mux)
+    scene = load("rigid_chaos", ["video.width=160", "video.height=90", "video.duration=0.5", "video.fps=10",
+                                 "pendulums.count=8"])
+    t = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        pipeline.render(scene, tmp_path / "out")
+    assert time.perf_counter() - t < 30 and procs and procs[0].poll() is not None  # killed, not waited out
+    assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
+
+
 def test_a_cleanup_that_fails_too_does_not_hide_the_failure(tmp_path, monkeypatch):
     """A full disk as metadata.json is written, in a folder where the temporaries cannot be removed either: the
     error reported is the full disk's, not the cleanup's (which named a hidden temporary), and every temporary

@@ -14,6 +14,7 @@ import shutil
 import signal
 import socket
 import subprocess
+import tempfile
 import sys
 import threading
 import time
@@ -359,3 +360,30 @@ def test_a_sigterm_that_lands_in_a_finalizer_still_terminates_and_prints_nothing
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert r.stdout.strip() == "terminated" and r.stderr == "", (r.stdout, r.stderr)
 
+
+
+@pytest.mark.parametrize("sig, code, said", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_whose_exception_is_swallowed_or_replaced_is_still_the_one_reported(sig, code, said):
+    """Ctrl-C while Taichi decorates a kernel, or while numpy views an mmap, came out as "unexpected error:
+    TaichiSyntaxError ..." or "BufferError ...", exit 1, or was lost and the run ended 0. The signal is the
+    cause: main() reports it, whatever it turned into on the way out."""
+    code_text = f"""if True:
+        import os, signal, sys
+        from render.commands import cli
+        from render.video import pipeline
+
+        def render(*a, **k):
+            try:
+                os.kill(os.getpid(), {int(sig)})
+            except BaseException:
+                raise RuntimeError("cannot close exported pointers exist")  # as an mmap's close said
+        pipeline.render = render
+        sys.exit(cli.main(["render", "classic", "--out", sys.argv[1], "--no-progress"]))
+    """
+    for variant in (code_text, code_text.replace('raise RuntimeError("cannot close exported pointers exist")',
+                                                 "pass  # swallowed")):
+        with tempfile.TemporaryDirectory() as out:
+            r = subprocess.run([sys.executable, "-c", variant, out], cwd=ROOT, capture_output=True, text=True,
+                               timeout=120)
+        assert r.returncode == code and r.stderr.strip().splitlines() == [f"pendulum: {said}; no partial output "
+                                                                          f"was left"], r.stderr

@@ -176,28 +176,30 @@ def cmd_presets(args) -> int:
 
 # Distributions whose import name differs: what `pip install` takes for a module found missing.
 DISTRIBUTIONS = {"dask": "dask[distributed]", "distributed": "dask[distributed]", "imageio_ffmpeg": "imageio-ffmpeg"}
-STOPS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)  # what stops a run, its cleanup done (on_signals)
 RESEND_S = 0.005  # a signal lost in a finalizer comes again this much later: the finalizer has returned by then
+stopped_by: int | None = None  # the signal that stopped this run, once one came (main() reports it, and only it)
 
 
 def on_signals():
-    """SIGTERM raises Terminated and SIGINT KeyboardInterrupt, so that every cleanup runs (main() says one line).
-    A process started in the background by a non-interactive shell inherits SIGINT ignored, and Python then
-    installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run on. A signal that lands in
-    a finalizer (a __del__ of llvmlite's, say) raises there, where Python only prints the exception and goes on
-    (a SIGTERM was lost so): the signal is sent again from a thread, so its handler runs once the finalizer has
-    returned, and nothing is printed. Once one has come, the others are held off: a second Ctrl-C or SIGTERM
-    (a batch's workers get both the group's and the parent's) would cut the cleanup short and leave partial files."""
-    def stopping():
-        for s in STOPS:
-            signal.signal(s, signal.SIG_IGN)
+    """SIGTERM and SIGHUP (the terminal closed) raise Terminated, SIGINT KeyboardInterrupt, so that every cleanup
+    runs (main() says one line). A process started in the background by a non-interactive shell inherits SIGINT
+    ignored, and Python then installs no KeyboardInterrupt for it: `kill -INT` would be lost and the render run
+    on. A signal that lands in a finalizer (a __del__ of llvmlite's, say) raises there, where Python only prints
+    the exception and goes on (a SIGTERM was lost so): the signal is sent again from a thread, so its handler
+    runs once the finalizer has returned, and nothing is printed. Each one is remembered in `stopped_by`: an
+    exception it turns into on its way out (Taichi's or numpy's, raised while it unwound their state) or one
+    swallowed on the way is still reported as the interruption it was."""
+    global stopped_by
+    stopped_by = None  # a run of its own (tests call main() again in one process)
 
     def on_term(signum, frame):
-        stopping()
+        global stopped_by
+        stopped_by = signum
         raise Terminated(signum)
 
     def on_int(signum, frame):
-        stopping()
+        global stopped_by
+        stopped_by = signum
         raise KeyboardInterrupt
 
     def resend(signum):
@@ -208,18 +210,21 @@ def on_signals():
         for kind, signum in ((Terminated, signal.SIGTERM), (KeyboardInterrupt, signal.SIGINT)):
             if isinstance(info.exc_value, kind):  # raised here, the handler would run inside this hook; and
                 signum = getattr(info.exc_value, "signum", signum)
-                listen()  # the resent signal must reach a handler, not the ignoring that stopping() set
                 _thread.start_new_thread(resend, (signum,))  # Thread.start() waits for its thread, so it would too
                 return
         passed_on(info)
 
-    def listen():
-        signal.signal(signal.SIGTERM, on_term)
-        signal.signal(signal.SIGHUP, on_term)
-        signal.signal(signal.SIGINT, on_int)
-
-    listen()
+    signal.signal(signal.SIGTERM, on_term)
+    signal.signal(signal.SIGHUP, on_term)
+    signal.signal(signal.SIGINT, on_int)
     sys.unraisablehook = unraisable
+
+
+def stopped(signum: int) -> int:
+    """Say that a signal stopped the run; its exit code."""
+    what = {signal.SIGINT: "interrupted", signal.SIGHUP: "hung up"}.get(signum, "terminated")
+    print(f"pendulum: {what}; no partial output was left", file=sys.stderr)
+    return 128 + signum
 
 
 def main(argv=None) -> int:
@@ -229,21 +234,19 @@ def main(argv=None) -> int:
     debug = "--debug" in argv or os.environ.get("PENDULUM_DEBUG", "") not in ("", "0")
     try:
         args = build_parser(argv).parse_args(argv)
-        return args.func(args)
+        code = args.func(args)
+        return code if stopped_by is None else stopped(stopped_by)  # a signal swallowed on the way
     except SceneError as e:
         return fail(2, "error", e, debug)
     except (SimulationError, EncodeError, BatchError) as e:
         return fail(1, "failed", e, debug)
     except KeyboardInterrupt:
-        print("pendulum: interrupted; no partial output was left", file=sys.stderr)
-        return 130
+        return stopped(signal.SIGINT)
     except BrokenPipeError:  # e.g. `pendulum presets | head`
         sys.stdout = open(os.devnull, "w")
         return 0
     except Terminated as e:
-        what = "hung up" if e.signum == signal.SIGHUP else "terminated"
-        print(f"pendulum: {what}; no partial output was left", file=sys.stderr)
-        return 128 + e.signum
+        return stopped(e.signum)
     except OSError as e:  # the file system while running: a full disk, a vanished folder, permissions
         where = f": {e.filename}" if e.filename else ""
         return fail(1, "failed", f"{e.strerror or e}{where}", debug)
@@ -271,7 +274,10 @@ def missing(e: Exception) -> str | None:
 
 
 def fail(code: int, kind: str, error, debug: bool) -> int:
-    """Report an error as one line on stderr (with the traceback first under --debug); return the code."""
+    """Report an error as one line on stderr (with the traceback first under --debug); return the code. An error
+    raised while a signal unwound the run is that signal's doing: the signal is reported."""
+    if stopped_by is not None and not debug:
+        return stopped(stopped_by)
     if debug:
         traceback.print_exc()  # called from an except block: the exception being handled
     print(f"pendulum: {kind}: {one_line(str(error))}", file=sys.stderr)

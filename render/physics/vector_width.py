@@ -132,7 +132,9 @@ def _symbols(path: str, names: tuple[str, ...]) -> dict[str, int]:
             if kind != 2:  # SHT_SYMTAB
                 continue
             str_at, str_size = sections[link][4], sections[link][5]
-            syms = np.frombuffer(m, _SYM, size // _SYM.itemsize, offset)
+            # a copy, not a view: an mmap with a view of it alive cannot close, and an interrupt here would then
+            # end as BufferError ("cannot close exported pointers exist") instead of itself
+            syms = np.frombuffer(m[offset:offset + size // _SYM.itemsize * _SYM.itemsize], _SYM)
             funcs = syms[(syms["info"] & 0xF) == 2]  # STT_FUNC
             for name in names:
                 # a name may end another one in the string table, so every place it ends a string counts
@@ -144,7 +146,6 @@ def _symbols(path: str, names: tuple[str, ...]) -> dict[str, int]:
                 hit = funcs["value"][np.isin(funcs["name"], starts)]
                 if len(hit) == 1:
                     found[name] = int(hit[0])
-            del syms, funcs  # the mmap cannot close while numpy holds a view of it
     return found
 
 

@@ -52,6 +52,7 @@ class Encoder:
         self.targets: list[Pipe] = []
         self.written = 0
         self.stills: list[_Still] = []
+        self.muxers: list = []  # the audio mux's ffmpeg while it runs (close())
         self.size = (video.width, video.height)
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         loose = None  # a format's temporary, ffmpeg and log until self.targets holds them, where abort() sees them
@@ -170,16 +171,18 @@ class Encoder:
                     self._gif(t, palette.read(rgba))
             for s in self.stills:
                 s.finish()
-        except BaseException:
             if muxing is not None:
+                muxing.join()
+        except BaseException:  # a failure, or stopped (Ctrl-C) in any of it, the mux's wait too
+            if muxing is not None:
+                for proc in self.muxers:
+                    proc.kill()  # in a session of its own: no signal of ours reached it
                 muxing.join()  # its temporary file is removed, or renamed onto the MP4's, before abort() runs
             self.abort()
             raise
-        if muxing is not None:
-            muxing.join()
-            if muxed:
-                self.abort()
-                raise muxed[0]
+        if muxed:
+            self.abort()
+            raise muxed[0]
         for t in self.targets:
             t.log.close()
         sizes = {t.final.name: t.tmp.stat().st_size for t in [*self.targets, *self.stills]}
@@ -219,7 +222,7 @@ class Encoder:
 
     def _mux(self, t: Pipe, rate: int, samples: np.ndarray):
         """The track into the finished MP4 (mp4.mux)."""
-        code = mp4.mux(t.final, t.tmp, t.log, rate, samples)
+        code = mp4.mux(t.final, t.tmp, t.log, rate, samples, self.muxers)
         if code:
             raise self._failure("failed adding the audio", f"exit status {code}")
 

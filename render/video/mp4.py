@@ -69,20 +69,29 @@ def args(video) -> list[str]:
             "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"]
 
 
-def mux(final, tmp, log, rate: int, samples: np.ndarray) -> int:
+def mux(final, tmp, log, rate: int, samples: np.ndarray, running: list | None = None) -> int:
     """Put the track into the finished MP4 at `tmp` (the temporary beside `final`): a second ffmpeg copies the
     video's packets as they are (the same H.264 stream as without audio) and encodes the samples, int16
     (S, 2) at `rate` Hz, piped to it, as AAC at AUDIO_RATE. No sound file is written; its output is another
-    temporary beside the final file, renamed onto `tmp`. Returns ffmpeg's exit status (its log: `log`)."""
+    temporary beside the final file, renamed onto `tmp`. Returns ffmpeg's exit status (its log: `log`). The
+    ffmpeg is put in `running` as it starts, for a caller on another thread to kill (Encoder.close, when it is
+    stopped while the mux runs on a thread of its own)."""
     out = temp_beside(final, suffix=".part")
     cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-y", "-loglevel", "error", "-i", tmp,
            "-f", "s16le", "-ar", str(rate), "-ac", "2", "-i", "-", "-map", "0:v", "-map", "1:a",
            "-c:v", "copy", "-c:a", AUDIO_CODEC, "-ar", str(AUDIO_RATE), "-b:a", f"{AUDIO_KBPS}k",
            "-movflags", "+faststart", "-f", "mp4", out]
-    try:  # run() kills ffmpeg if we are interrupted while it works
-        code = subprocess.run(cmd, input=memoryview(np.ascontiguousarray(samples, "<i2")).cast("B"),
-                              stdout=subprocess.DEVNULL, stderr=log, start_new_session=True,
-                              restore_signals=RESTORE_SIGNALS).returncode
+    try:
+        with subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=log,
+                              start_new_session=True, restore_signals=RESTORE_SIGNALS) as proc:
+            if running is not None:
+                running.append(proc)
+            try:
+                proc.communicate(memoryview(np.ascontiguousarray(samples, "<i2")).cast("B"))
+            except BaseException:  # interrupted while it works: it goes too
+                proc.kill()
+                raise
+        code = proc.returncode
         if code:
             discard(out)
             return code
