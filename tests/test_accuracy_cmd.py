@@ -67,3 +67,22 @@ def test_accuracy_bad_input_exits_2(tmp_path):
     r = run_cli("accuracy", "--quick", "--out", tmp_path / "acc", timeout=60)
     assert r.returncode == 2 and "summary.md: is a folder" in r.stderr and len(r.stderr.strip().splitlines()) == 1
     assert [p.name for p in (tmp_path / "acc").iterdir()] == ["summary.md"]
+
+
+def test_the_quality_table_writes_nothing_outside_the_output_folder(monkeypatch):
+    """It timed `simulate` with its .npz written into a temporary folder under $TMPDIR: outside --out, and a
+    full /tmp failed the command naming a file the user never named. The file is compressed into memory now."""
+    import tempfile
+    from render.commands import flagship
+
+    def in_tmpdir_refused(real):  # a folder given (Taichi's cache probe, say) is not $TMPDIR
+        def made(*a, **k):
+            if k.get("dir") is None and len(a) < 3:
+                raise AssertionError(f"a temporary under $TMPDIR, outside the output folder: {real.__name__}")
+            return real(*a, **k)
+        return made
+
+    for name in ("mkdtemp", "mkstemp", "TemporaryDirectory", "NamedTemporaryFile"):
+        monkeypatch.setattr(tempfile, name, in_tmpdir_refused(getattr(tempfile, name)))
+    rows = flagship.quality_table("cpu", True, lambda line: None)
+    assert [r["level"] for r in rows] == list(flagship.LEVELS) and all(r["wall_s"] > r["simulate_s"] for r in rows)
