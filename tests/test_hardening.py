@@ -283,6 +283,19 @@ def test_an_interrupt_while_the_track_is_muxed_stops_the_mux_and_leaves_nothing(
     assert nothing_in(tmp_path / "out"), list((tmp_path / "out").rglob("*"))
 
 
+@pytest.mark.parametrize("formats", ['["mp4"]', '["mp4", "gif"]'])
+def test_an_ffmpeg_that_writes_nothing_and_exits_0_fails_the_render(tmp_path, formats):
+    """A broken or stand-in ffmpeg (IMAGEIO_FFMPEG_EXE) that reads its frames and exits 0: a 0-byte MP4 was
+    published with exit 0, and the GIF's empty palette read "unexpected error: ValueError"."""
+    fake = tmp_path / "ffmpeg"
+    fake.write_text("#!/bin/sh\ncat > /dev/null\nexit 0\n")
+    fake.chmod(0o755)
+    r = run_user("render", "classic", "--out", "out", *TINY, "--set", f"video.formats={formats}", cwd=tmp_path,
+                 env={**os.environ, "IMAGEIO_FFMPEG_EXE": str(fake)})
+    one_line(r, 1, "failed", "ffmpeg")
+    assert "unexpected" not in r.stderr and nothing_in(tmp_path / "out"), (r.stderr, list(tmp_path.rglob("*")))
+
+
 def test_a_cleanup_that_fails_too_does_not_hide_the_failure(tmp_path, monkeypatch):
     """A full disk as metadata.json is written, in a folder where the temporaries cannot be removed either: the
     error reported is the full disk's, not the cleanup's (which named a hidden temporary), and every temporary

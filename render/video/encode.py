@@ -186,6 +186,10 @@ class Encoder:
         for t in self.targets:
             t.log.close()
         sizes = {t.final.name: t.tmp.stat().st_size for t in [*self.targets, *self.stills]}
+        if not all(sizes.values()):  # an ffmpeg that exits 0 having written nothing (a broken or stand-in one)
+            empty = [name for name, size in sizes.items() if not size]
+            self.abort()
+            raise EncodeError(f"ffmpeg wrote nothing into {', '.join(empty)}, and said nothing")
         if publish:
             self.publish()
         return sizes

@@ -32,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import gif
+from ..errors import EncodeError
 
 GIF_COLOURS, RAINBOW_COLOURS = 48, 256
 PALETTE_BITS = 7
@@ -74,7 +75,7 @@ def read(rgba: bytes) -> np.ndarray:
     the palette by repeating its last colour, and reserves a transparent entry)."""
     entries = np.frombuffer(rgba, np.uint8).reshape(-1, 4)
     if len(entries) != 256:
-        raise ValueError(f"palettegen gave {len(rgba)} bytes, not a palette of 256 RGBA entries")
+        raise EncodeError(f"ffmpeg's palettegen gave {len(rgba)} bytes, not a palette of 256 RGBA entries")
     opaque = entries[entries[:, 3] == 255, :3]
     _, first = np.unique(opaque, axis=0, return_index=True)
     return np.ascontiguousarray(opaque[np.sort(first)], np.int32)
