@@ -259,3 +259,37 @@ def test_assembly_undoes_the_deltas():
     asm = tiles.Assembly(sc, results)
     for f in range(3):
         assert np.array_equal(asm.frame(f), whole[f])
+
+
+def test_ctrl_c_during_a_tiled_render_is_one_line(tmp_path):
+    """Ctrl-C goes to the terminal's whole process group, the local cluster's worker processes too: each printed
+    its KeyboardInterrupt's traceback (67-86 lines) beside our one line. Sent as the workers start."""
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+    proc = subprocess.Popen([sys.executable, "-m", "render", "render", "fractal_flip",
+                             *(a for s in SETS for a in ("--set", s)), "--set", "video.duration=30", "--tiles", "2",
+                             "--out", str(tmp_path / "out"), "--no-progress"], cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and not any("multiprocessing.spawn" in p.read_bytes().decode(errors="replace")
+                                                 for p in Path("/proc").glob("[0-9]*/cmdline")
+                                                 if _child_of(p.parent, proc.pid)):
+            time.sleep(0.02)
+        time.sleep(0.3)  # the workers are importing: where a Ctrl-C made them print
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130 and err.splitlines() == ["pendulum: interrupted; no partial output was left"], err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))
+
+
+def _child_of(proc_dir: Path, pid: int) -> bool:
+    try:
+        return int((proc_dir / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid
+    except (OSError, ValueError, IndexError):
+        return False

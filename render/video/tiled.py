@@ -21,6 +21,7 @@ import time
 from contextlib import contextmanager, suppress
 
 from ..errors import BatchError, SceneError, SimulationError
+from .atomic import signals_held
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
 ENV = "DASK_SCHEDULER_ADDRESS"  # the cluster `batch` and a map's `render` use without --scheduler
@@ -127,11 +128,35 @@ def cluster(address: str | None, workers: int | None):
     from dask.distributed import Client, LocalCluster
     # its scratch space (lock files) in a folder removed after, not left in $TMPDIR/dask-scratch-space
     with tempfile.TemporaryDirectory(prefix="pendulum-dask-", ignore_cleanup_errors=True) as scratch, quiet(), \
-            dask.config.set({"temporary-directory": scratch}), \
-            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                         dashboard_address=None, silence_logs=logging.ERROR) as local, \
-            Client(local, set_as_default=False) as client:
-        yield client
+            dask.config.set({"temporary-directory": scratch}):
+        local = None
+        try:
+            # The worker processes write their stderr into the scratch folder: a Ctrl-C to the terminal's
+            # process group reaches them too, and each printed its KeyboardInterrupt's traceback beside our one
+            # line. One that reaches us meanwhile waits for the cluster to be whole (signals_held): one closed
+            # half-started printed more at exit.
+            with signals_held(), stderr_into(os.path.join(scratch, "workers.log")):
+                local = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                     dashboard_address=None, silence_logs=logging.ERROR)
+        except BaseException:
+            if local is not None:
+                local.close()
+            raise
+        with local, Client(local, set_as_default=False) as client:
+            yield client
+
+
+@contextmanager
+def stderr_into(path: str):
+    """File descriptor 2 into `path` within the block, for the processes started there; ours afterwards."""
+    saved, into = os.dup(2), os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+    try:
+        os.dup2(into, 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(into)
 
 
 class TiledSource:
