@@ -2,7 +2,7 @@
 each part of it, from per-machine rates.
 
 Parts: `start` (Taichi's start, the kernels' compiles, ffmpeg's start), `simulate` (the render's own run),
-`certificate` (render/trust/certify.py: the certified pendulums, up to 128, run again at the render's settings and
+`certificate` (render/trust/certify.py: the certified pendulums, all of them up to its memory cap, run again at the render's settings and
 by the shadow: RK4 at the same step, or an order-4 method at a quarter of it, in f64), `quality` (the pilot
 runs of --quality, render/trust/quality.py), and `draw+encode` (per frame: a fixed cost, a cost per pixel, one per
 drawn link, the HUD, an FTLE map's σ of every point; x264 per pixel of every frame, the GIF's ffmpeg of every
@@ -160,7 +160,7 @@ def physics(scene, rates: dict) -> tuple[dict, float, int]:
     parts["simulate"] = run_s(scene, rates, i.method, i.precision, substeps, n)
     if scene.fractal == "lyapunov":
         parts["simulate"] *= FTLE_COST
-    certified = len(grid.trust_indices(scene)) if scene.fractal else min(n, certify.SUBSAMPLE)
+    certified = len(grid.trust_indices(scene)) if scene.fractal else len(certify.certified(scene))
     shadow = certify.shadow_scene(scene, h).integrator
     _, shadow_substeps = pinned(scene, shadow.dt)
     parts["certificate"] = (run_s(scene, rates, i.method, i.precision, substeps, certified)

@@ -28,7 +28,7 @@ no smaller barrier holds (tests/test_fractal.py: a DOP853 run flips no pixel ins
 above B_k with link k just short of the top do flip).
 
 **The trust mask.** A pixel shows a claim about its trajectory up to min(t, its event time). The
-certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_indices) instead of its usual 128
+certificate (render/trust/certify.py) runs on a lattice of pixels (grid.trust_indices) instead of a fan's evenly spaced
 pendulums, and each pixel's faithful time is the least of its lattice neighbours' (grid.faithful_map). A
 pixel whose claim reaches past that time is drawn desaturated and hatched. Pixels that cannot flip are
 trusted: energy, not the integration, settles them.

@@ -13,8 +13,10 @@ trajectory by nearly the same amount after a few seconds (ratio 1.6, not 16: cha
 and truncation leave alike), while a quarter step is 16x closer. A shadow must be clearly better, not
 better by theory.
 
-Both runs cover only a subsample of at most SUBSAMPLE pendulums, evenly spaced over the fan (the ends
-included), and run before the render: pendulums are independent, so the subsample's main run is the
+Both runs cover every pendulum while their states at every frame fit in CERTIFY_BYTES (every shipped preset's
+fan: rainbow_1000's first pendulum breaks at 6.72 s, where its 128 evenly spaced ones, as certified before,
+said 7.60 s), else a subsample of as many as fit and at least SUBSAMPLE, evenly spaced over the fan (the ends
+included). They run before the render: pendulums are independent, so the certified pendulums' main run is the
 render's, and a render that would be untrue can stop before it writes anything.
 """
 from __future__ import annotations
@@ -28,7 +30,11 @@ from ..physics import integrators, registry
 from ..physics.stepper import Run
 from ..errors import SimulationError
 
-SUBSAMPLE = 128  # pendulums certified; every one of them when a scene has no more
+SUBSAMPLE = 128  # pendulums certified at the least (every one, when a scene has no more)
+# What the certified pendulums' recorded states may take: the main run's and the shadow's, Taichi's record of
+# each, and their difference, 4 float64s a coordinate a frame in all; beyond it a long video's large fan is
+# certified on a subsample
+CERTIFY_BYTES = 256 << 20
 HISTOGRAM_ABOVE = 64  # per-pendulum times in metadata up to this many, a histogram beyond
 
 
@@ -78,6 +84,13 @@ class Certificate:
 
 def subsample(count: int, limit: int = SUBSAMPLE) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, count - 1, min(count, limit))).astype(np.int64))
+
+
+def certified(scene) -> np.ndarray:
+    """The pendulums a fan's certificate runs: all of them while their states fit in CERTIFY_BYTES, else as
+    many as fit (at least SUBSAMPLE), evenly spaced."""
+    each = 4 * 8 * registry.get(scene.system).D * (scene.frames + 1)
+    return subsample(scene.pendulums.count, max(SUBSAMPLE, CERTIFY_BYTES // each))
 
 
 MARGIN = 1.1  # the shadow's own error is below a tenth of the main run's: e ≤ 1.1·d
@@ -137,7 +150,7 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
     """Run the main settings and the shadow on a subsample; per pendulum, until when they agree."""
     t0 = time.perf_counter()
     if indices is None:
-        indices = subsample(scene.pendulums.count)
+        indices = certified(scene)
     key = _key(scene, arch, threads, indices)
     if key in _MEMO:
         cert, h = _MEMO.pop(key)

@@ -57,7 +57,7 @@ FRAME_S = 5e-3  # the launches and QR of one frame, whatever the pendulums (meas
 
 def default_pendulums(scene) -> np.ndarray:
     """The certificate's pendulums (render/trust/certify.py; a map's trust lattice), thinned evenly to CAP."""
-    certified = grid.trust_indices(scene) if scene.fractal else certify.subsample(scene.pendulums.count)
+    certified = grid.trust_indices(scene) if scene.fractal else certify.certified(scene)
     return certified[certify.subsample(len(certified), CAP)]
 
 
