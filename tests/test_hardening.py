@@ -363,6 +363,26 @@ def test_a_publish_that_fails_halfway_puts_the_earlier_result_back(tmp_path, mon
     assert not list(fresh.iterdir())
 
 
+def test_a_publish_that_cannot_keep_the_earlier_files_removes_its_temporaries(tmp_path, monkeypatch):
+    """Keeping the earlier result fails (the folder made unwritable, say) before any rename: nothing is renamed,
+    the earlier files stay, and no temporary of ours is left."""
+    import errno
+    from render.video import atomic
+    (tmp_path / "a.mp4").write_text("old")
+    pairs = [(atomic.temp_beside(tmp_path / n), tmp_path / n) for n in ("a.mp4", "metadata.json")]
+    real = atomic._keep
+
+    def keep(path):
+        if path.name == "metadata.json":
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return real(path)
+
+    monkeypatch.setattr(atomic, "_keep", keep)
+    with pytest.raises(PermissionError):
+        atomic.publish_all(pairs)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.mp4"] and (tmp_path / "a.mp4").read_text() == "old"
+
+
 def test_a_signal_during_the_renames_comes_after_them(tmp_path):
     """SIGINT as the renames go (the second one here) is delivered when all are done: a render is published whole,
     then interrupted, never cut between its video and its metadata.json."""

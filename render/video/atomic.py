@@ -103,25 +103,27 @@ def publish_all(pairs: list[tuple[Path, Path]]):
     metadata.json are one result. A final file already there (an earlier run's) is first kept under a hidden
     hard link, and put back if a later rename fails, so a failure leaves the earlier result whole, never half of
     each; without hard links (a file system that has none) a failure leaves none of the files it replaced.
-    SIGINT and SIGTERM that arrive meanwhile are delivered when the renames are done (signals_held)."""
+    SIGINT, SIGTERM and SIGHUP that arrive meanwhile are acted on when the renames are done (signals_held). On
+    a failure every temporary not yet renamed is removed too."""
     with signals_held():
         kept: list[Path | None] = []
+        done = 0
         try:
-            for tmp, path in pairs:
+            for _, path in pairs:
                 kept.append(_keep(path))
-            for i, (tmp, path) in enumerate(pairs):
-                try:
-                    publish(tmp, path)
-                except BaseException:
-                    for (_, done), old in zip(pairs[:i], kept):  # put the earlier result back, or none of this one
-                        if old is None:
-                            discard(done)
-                        else:
-                            with contextlib.suppress(OSError):
-                                os.replace(old, done)
-                    for waiting, _ in pairs[i:]:
-                        discard(waiting)
-                    raise
+            for tmp, path in pairs:
+                publish(tmp, path)
+                done += 1
+        except BaseException:
+            for (_, path), old in zip(pairs[:done], kept):  # put the earlier result back, or none of this one
+                if old is None:
+                    discard(path)
+                else:
+                    with contextlib.suppress(OSError):
+                        os.replace(old, path)
+            for waiting, _ in pairs[done:]:
+                discard(waiting)
+            raise
         finally:
             for old in kept:
                 if old is not None:
