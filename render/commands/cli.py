@@ -223,7 +223,10 @@ def on_signals():
 def stopped(signum: int) -> int:
     """Say that a signal stopped the run; its exit code."""
     what = {signal.SIGINT: "interrupted", signal.SIGHUP: "hung up"}.get(signum, "terminated")
-    print(f"pendulum: {what}; no partial output was left", file=sys.stderr)
+    try:
+        print(f"pendulum: {what}; no partial output was left", file=sys.stderr)
+    except OSError:  # hung up: the terminal, and stderr with it, may be gone
+        pass
     return 128 + signum
 
 
