@@ -20,8 +20,7 @@ import imageio_ffmpeg
 import numpy as np
 
 from . import gif, mp4, palette
-from . import pipe
-from .pipe import Pipe, ends, os_error
+from .pipe import RESTORE_SIGNALS, Pipe, ends, os_error
 from .atomic import discard, publish_all, temp_beside
 from ..errors import EncodeError
 
@@ -77,7 +76,7 @@ class Encoder:
                 # start_new_session: Ctrl-C reaches us, not ffmpeg, and we clean up
                 proc = loose[1] = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=log, start_new_session=True,
                                                    stdout=subprocess.PIPE if own else subprocess.DEVNULL,
-                                                   restore_signals=pipe.RESTORE_SIGNALS)
+                                                   restore_signals=RESTORE_SIGNALS)
                 t = Pipe(final, tmp, proc, log, gif.repeats(video, frames) if fmt == "gif" else None,
                          gif.size(video) if fmt == "gif" else None, planar)
                 if own:

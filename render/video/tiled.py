@@ -21,6 +21,7 @@ import time
 from contextlib import contextmanager, suppress
 
 from ..errors import BatchError, SceneError, SimulationError
+from ..physics import held_stderr
 from .atomic import signals_held
 
 RETRIES = 2  # reruns of a band that raised (a worker's death is the scheduler's to retry)
@@ -131,11 +132,11 @@ def cluster(address: str | None, workers: int | None):
             dask.config.set({"temporary-directory": scratch}):
         local = None
         try:
-            # The worker processes write their stderr into the scratch folder: a Ctrl-C to the terminal's
-            # process group reaches them too, and each printed its KeyboardInterrupt's traceback beside our one
-            # line. One that reaches us meanwhile waits for the cluster to be whole (signals_held): one closed
-            # half-started printed more at exit.
-            with signals_held(), stderr_into(os.path.join(scratch, "workers.log")):
+            # The worker processes start with fd 2 held (render/physics/held_stderr.py), and what they write there
+            # is dropped: a Ctrl-C to the terminal's process group reaches them too, and each printed its
+            # KeyboardInterrupt's traceback beside our one line. One that reaches us meanwhile waits for the
+            # cluster to be whole (signals_held): one closed half-started printed more at exit.
+            with signals_held(), held_stderr.held(lambda text, ok: b""):
                 local = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                                      dashboard_address=None, silence_logs=logging.ERROR)
         except BaseException:
@@ -144,19 +145,6 @@ def cluster(address: str | None, workers: int | None):
             raise
         with local, Client(local, set_as_default=False) as client:
             yield client
-
-
-@contextmanager
-def stderr_into(path: str):
-    """File descriptor 2 into `path` within the block, for the processes started there; ours afterwards."""
-    saved, into = os.dup(2), os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-    try:
-        os.dup2(into, 2)
-        yield
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(into)
 
 
 class TiledSource:
