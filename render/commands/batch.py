@@ -21,7 +21,7 @@ from ..config import budget
 from . import gallery
 from .batch_plan import expand_refs, parse_sweeps, plan
 from ..physics import registry
-from ..video.atomic import write_atomic
+from ..video.atomic import output_dir, write_atomic
 from ..errors import BatchError, SceneError
 from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
                               out_path, positive_int, progress_wanted, thread_count, usable_cores)
@@ -91,6 +91,10 @@ def _worker_init():
     signal.signal(signal.SIGHUP, signal.SIG_IGN)  # a closed terminal reaches the parent too, which stops us
     signal.signal(signal.SIGTERM, _stop)
     os.dup2(2, 1)  # Taichi's start-up line would interleave with the parent's summary table on stdout
+    # tqdm makes a multiprocessing lock for any bar, a disabled one too: a named semaphore that the resource
+    # tracker reported as leaked, on stderr after "interrupted", when a stopped worker left by os._exit
+    from tqdm import tqdm
+    tqdm.set_lock(threading.RLock())
 
 
 def _stop(signum, frame):
@@ -219,8 +223,9 @@ def run(args) -> int:
             results = run_local(todo, out_root, jobs, args.arch, threads, args.digest,
                                 jobs == 1 and progress_wanted(args))
         try:
-            for row in results:
-                report(row)
+            with output_dir(out_root):  # made here, not by the first worker: removed again if stopped while empty
+                for row in results:
+                    report(row)
         except BatchError as e:
             print(f"pendulum: failed: {e}", file=sys.stderr)
             return 1

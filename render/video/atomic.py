@@ -199,28 +199,32 @@ def naming(path: Path):
 
 
 @contextmanager
+def output_dir(path: Path):
+    """Make the folder (with its missing parents); if the block fails, remove again what was made here and is
+    left empty: a failed or interrupted command leaves no empty folder behind."""
+    made = []  # the folders made here, the deepest first
+    here = Path(path)
+    while not os.path.lexists(here):
+        made.append(here)
+        here = here.parent
+    Path(path).mkdir(parents=True, exist_ok=True)
+    try:
+        yield Path(path)
+    except BaseException:
+        for folder in made:
+            with contextlib.suppress(OSError):  # not empty: something else was put there meanwhile
+                folder.rmdir()
+        raise
+
+
+@contextmanager
 def together(folder: Path | None = None):
     """A command's files appear together or not at all: within the block, each file replacing() and
     write_atomic() finish stays in its temporary; all are published, in the order written, when the block
     succeeds, and none is when it fails (their temporaries are removed). A chart written before a failing
-    table is not left behind without it. `folder`, where they go, is made here if missing (with its missing
-    parents), and what was made is removed again if the block fails and leaves it empty: a failed command
-    leaves no empty folder behind either."""
-    made = []  # the folders made here, the deepest first
-    if folder is not None:
-        here = Path(folder)
-        while not os.path.lexists(here):
-            made.append(here)
-            here = here.parent
-        Path(folder).mkdir(parents=True, exist_ok=True)
-    try:
-        with _together():
-            yield
-    except BaseException:
-        for path in made:
-            with contextlib.suppress(OSError):  # not empty: something else was put there meanwhile
-                path.rmdir()
-        raise
+    table is not left behind without it. `folder`, where they go, is made here if missing (output_dir)."""
+    with output_dir(folder) if folder is not None else contextlib.nullcontext(), _together():
+        yield
 
 
 @contextmanager

@@ -5,7 +5,6 @@ import dataclasses
 import json
 import sys
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,7 @@ from . import audio
 from ..trust import certify, faithful, quality
 from ..physics import grid, runtime
 from ..physics.stepper import Run
-from .atomic import digest, discard, naming, replacing, signals_held, temp_beside
+from .atomic import digest, discard, naming, output_dir, replacing, signals_held, temp_beside
 from .files import read_regular
 from .metadata import integrator_meta, metadata, run_meta
 
@@ -43,22 +42,6 @@ def progress_bar(total: int, desc: str, enabled: bool):
     from tqdm import tqdm
     return tqdm(total=total, desc=desc, unit="frame", file=sys.stderr, disable=not enabled, leave=False,
                 dynamic_ncols=True)
-
-
-@contextmanager
-def output_dir(path: Path):
-    """Create the directory; if the block fails, remove it again, and the parents it made, when empty."""
-    made = [p for p in (path, *path.parents) if not p.exists()]  # e.g. out/compare/ for a first comparison
-    path.mkdir(parents=True, exist_ok=True)
-    try:
-        yield path
-    except BaseException:
-        for p in made:  # deepest first
-            try:
-                p.rmdir()
-            except OSError:
-                break
-        raise
 
 
 class Source:
