@@ -3,7 +3,7 @@ each part of it, from per-machine rates.
 
 Parts: `start` (Taichi's start, the kernels' compiles, ffmpeg's start), `simulate` (the render's own run),
 `certificate` (render/trust/certify.py: the certified pendulums, all of them up to its memory cap, run again at the render's settings and
-by the shadow: RK4 at the same step, or an order-4 method at a quarter of it, in f64), `quality` (the pilot
+by the shadow: RK4 in f64 at the same step, or at an eighth of an order-4 method's), `quality` (the pilot
 runs of --quality, render/trust/quality.py), and `draw+encode` (per frame: a fixed cost, a cost per pixel, one per
 drawn link, the HUD, an FTLE map's σ of every point; x264 per pixel of every frame, the GIF's ffmpeg of every
 frame it keeps), or `write` for `simulate`'s .npz.

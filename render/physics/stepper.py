@@ -37,10 +37,11 @@ class Run:
 
     precision: the runtime's, where it is not the scene's (a comparison draws every panel from f64 states).
     keep_log: add this run's kernels and fields to those logged so far (runtime.launched, .allocated: what
-    metadata reports), as one drawing pass of several systems does, instead of starting the log afresh."""
+    metadata reports), as one drawing pass of several systems does, instead of starting the log afresh.
+    compensated: RK4 with compensated sums, the certificate's shadow (System)."""
 
     def __init__(self, scene, arch: str = "cpu", threads: int | None = None, subset=None,
-                 precision: str | None = None, keep_log: bool = False):
+                 precision: str | None = None, keep_log: bool = False, compensated: bool = False):
         # Taichi is imported with the first Run, not with this module: the certificate's and the quality
         # levels' modules import Run, and the run-time estimate reads their sizes without running anything.
         from . import runtime
@@ -48,7 +49,7 @@ class Run:
         self.scene = scene
         self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log)  # the one in use
         self.generation = runtime.generation()
-        self.sim = build(scene, subset, precision)
+        self.sim = build(scene, subset, precision, compensated)
 
     @property
     def current(self) -> bool:
@@ -127,11 +128,12 @@ HOST_ONLY = ("scene", "subset", "h", "substeps")  # what the kernels take as arg
 _built: list = []  # (generation, constants, system, bytes of its fields by name) of this process's systems
 
 
-def build(scene, subset=None, precision: str | None = None):
+def build(scene, subset=None, precision: str | None = None, compensated: bool = False):
     """The scene's system in the current runtime: a free one built earlier with the same constants, loaded
-    with this scene's start, or a new one."""
+    with this scene's start, or a new one (compensated: see System)."""
     from . import runtime
-    plan = registry.kernels(scene.system)(scene, subset, allocate=False)  # the step and the constants, no field
+    # the step and the constants, no field
+    plan = registry.kernels(scene.system)(scene, subset, allocate=False, compensated=compensated)
     key = constants(plan, precision or scene.integrator.precision)
     _built[:] = [b for b in _built if b[0] == runtime.generation()]  # a restart freed the others' fields
     same = [entry for entry in _built if key is not None and entry[1] == key]
@@ -146,7 +148,7 @@ def build(scene, subset=None, precision: str | None = None):
                 runtime.allocated[name] = runtime.allocated.get(name, 0) + size
             return sim
     before = dict(runtime.allocated)
-    sim = registry.kernels(scene.system)(scene, subset)
+    sim = registry.kernels(scene.system)(scene, subset, compensated=compensated)
     if key is not None:
         _built.append((runtime.generation(), key, sim,
                        {k: v - before.get(k, 0) for k, v in runtime.allocated.items() if v != before.get(k, 0)}))

@@ -83,6 +83,14 @@ def rk2(sys: ti.template(), q, v, h):
 
 @ti.func
 def rk4(sys: ti.template(), q, v, h):
+    dq, dv = rk4_increment(sys, q, v, h)
+    return q + dq, v + dv
+
+
+@ti.func
+def rk4_increment(sys: ti.template(), q, v, h):
+    """What one RK4 step adds to (q, v): rk4's own arithmetic, so rk4 gives the same bits, and the
+    certificate's shadow adds it with compensated sums (System.advance_group)."""
     a1 = sys.force(q, v)
     q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
     a2 = sys.force(q2, v2)
@@ -90,7 +98,20 @@ def rk4(sys: ti.template(), q, v, h):
     a3 = sys.force(q3, v3)
     q4, v4 = q + h * v3, v + h * a3
     a4 = sys.force(q4, v4)
-    return q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), v + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    return h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4), h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+
+
+@ti.func
+def add_compensated(x, dx, carry):
+    """x + dx by Kahan's compensated sum: (the new x, the new carry), the carry holding what the rounding of
+    the sum lost. Over the 10^5-10^6 steps of a run, plain sums let the state's rounding (half an ulp of the
+    angle a step, biased alike in runs at other steps) grow to 1e-11 rad and more, and chaos grows it to the
+    tolerance: an RK4 shadow at a quarter of the step then erred as much as the run it checks, and alike
+    (render/trust/certify.py).
+    Needs IEEE arithmetic (fast_math off, runtime.init), or (t − x) − y folds to 0."""
+    y = dx - carry
+    t = x + y
+    return t, (t - x) - y
 
 
 @ti.func

@@ -26,10 +26,15 @@ BLOWN = 100.0  # a relative energy drift this large is a blow-up, not a drift
 class System(Plan, Recording, runtime.Launcher):
     """Base of the systems' @ti.data_oriented classes."""
 
-    def __init__(self, scene, subset=None, allocate: bool = True):
+    def __init__(self, scene, subset=None, allocate: bool = True, compensated: bool = False):
         """The plan (Plan.start), and its state in Taichi fields. Without `allocate` only the plan and the
-        Taichi functions, no field: a twin whose functions another kernel calls (tangent.libm_twin)."""
+        Taichi functions, no field: a twin whose functions another kernel calls (tangent.libm_twin).
+        compensated: RK4 whose steps are added to the state by compensated sums (steps.add_compensated), with
+        the carries in fields of their own: the certificate's shadow (render/trust/certify.py)."""
         q0, v0 = self.start(scene, subset)
+        self.compensated = compensated
+        if compensated and (self.method != "rk4" or scene.integrator.trig == "libm"):
+            raise ValueError(f"compensated sums are for RK4 with inline sin/cos, not {self.method}")
         self.libm = scene.integrator.trig == "libm"
         self.damped = scene.has("damping")
         self.damping = scene.pendulums.damping
@@ -43,6 +48,9 @@ class System(Plan, Recording, runtime.Launcher):
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
         self.bad = runtime.field("watchdog.bad", ti.i32, ())
+        if compensated:
+            self.cq = runtime.field("state.q_carry", real, self.n, self.D)
+            self.cv = runtime.field("state.v_carry", real, self.n, self.D)
         if self.poincare:
             crossings.allocate(self)
         self.load(q0, v0)
@@ -59,6 +67,9 @@ class System(Plan, Recording, runtime.Launcher):
         self.q.from_numpy(q0.astype(dtype))
         self.v.from_numpy(v0.astype(dtype))
         self.bad[None] = self.n
+        if self.compensated:
+            self.cq.fill(0)
+            self.cv.fill(0)
         if self.poincare:
             self.crossed.fill(0)
         self.t = 0.0
@@ -176,9 +187,12 @@ class System(Plan, Recording, runtime.Launcher):
         at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
         B = ti.static(self.chunk)
         Q, V = ti.Matrix.zero(float, self.D, B), ti.Matrix.zero(float, self.D, B)
+        CQ, CV = Q, V  # compensated sums' carries (unused without: optimised out)
         for lane in range(B):
             i = ti.min(g * B + lane, self.n - 1)
             Q[:, lane], V[:, lane] = self.q[i], self.v[i]
+            if ti.static(self.compensated):
+                CQ[:, lane], CV[:, lane] = self.cq[i], self.cv[i]
         Q0, V0 = Q, V  # each step's start, for the section's crossings (unused without: optimised out)
         if ti.static(self.poincare):
             for lane in range(B):
@@ -188,8 +202,13 @@ class System(Plan, Recording, runtime.Launcher):
             if ti.static(self.poincare):
                 Q0, V0 = Q, V
             for lane in range(B):  # the loop LLVM vectorises
-                q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
-                Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
+                if ti.static(self.compensated):
+                    dq, dv = steps.rk4_increment(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                    Q[:, lane], CQ[:, lane] = steps.add_compensated(Q[:, lane], dq[:, 0], CQ[:, lane])
+                    V[:, lane], CV[:, lane] = steps.add_compensated(V[:, lane], dv[:, 0], CV[:, lane])
+                else:
+                    q, v = steps.step(self, ti.Matrix.cols([Q[:, lane]]), ti.Matrix.cols([V[:, lane]]), h)
+                    Q[:, lane], V[:, lane] = q[:, 0], v[:, 0]
             if ti.static(self.poincare):  # a loop of its own: its branch leaves the step's SIMD
                 for lane in range(B):
                     crossings.detect(self, g * B + lane, s, ti.Matrix.cols([Q0[:, lane]]),
@@ -199,6 +218,8 @@ class System(Plan, Recording, runtime.Launcher):
             i = g * B + lane
             if i < self.n:
                 self.q[i], self.v[i] = Q[:, lane], V[:, lane]
+                if ti.static(self.compensated):
+                    self.cq[i], self.cv[i] = CQ[:, lane], CV[:, lane]
                 self.watch(i, Q[:, lane], V[:, lane])
 
     @ti.func

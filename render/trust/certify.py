@@ -1,8 +1,8 @@
 """The faithfulness certificate: until when each pendulum of a render is true to the physics, not round-off.
 
-A shadow integrates the same initial states far more accurately: in f64, with RK4 at the same step when the
-main method is of lower order (one order higher at least: its error is thousands of times smaller), and with
-the main method (order 4) at a quarter of the step otherwise. Per
+A shadow integrates the same initial states far more accurately: RK4 in f64 with compensated sums, at the
+same step when the main method is of lower order (one order higher at least: its error is thousands of times
+smaller), at an eighth of it (FINER) for an order-4 method. Per
 pendulum, the first frame at which the main run and the shadow differ by more than integrator.tolerance
 (rad on any angle; for springs a fraction of the total length) ends its faithful time. The difference d
 stands for the main run's error e up to the shadow's own, which these settings keep below a tenth of it
@@ -11,7 +11,15 @@ stands for the main run's error e up to the shadow's own, which these settings k
 Why not Richardson at half the step: on rigid_chaos in f64, RK4 at dt 1e-3 and at 5e-4 part from the true
 trajectory by nearly the same amount after a few seconds (ratio 1.6, not 16: chaos amplifies what round-off
 and truncation leave alike), while a quarter step is 16x closer. A shadow must be clearly better, not
-better by theory.
+better by theory. And better at every step: an independent review (2026-12-07, RK4 in 80-bit long double at
+2e-5 as the truth) found the earlier shadow, the main method itself at a quarter of the step with plain sums,
+claiming pendulums faithful after they had left the truth. In the round-off regime (RK4 f64 at dt 1e-4 or
+2e-4) its 4x as many roundings erred as much as the run, and alike, so they hid each other: 16 and 25 of
+rigid_chaos's 100 pendulums over-claimed, one by 4.1 s, and 4 of 8 in triple_chaos. At dt 1e-3 a quarter step
+was at times only 1.3x closer, not 256x (a pendulum's error grew 100-fold in 5 s at h/4 and 10-fold at h): 2
+over-claimed, by up to 0.6 s. Compensated sums and an eighth of the step: none of the 300, nor of the 8
+(claims 0.2-1.3 % short of the truth; tests/test_certify.py holds the shadow under a tenth of the run's error
+against a long-double reference).
 
 Both runs cover every pendulum while their states at every frame fit in CERTIFY_BYTES (every shipped preset's
 fan: rainbow_1000's first pendulum breaks at 6.72 s, where its 128 evenly spaced ones, as certified before,
@@ -94,22 +102,22 @@ def certified(scene) -> np.ndarray:
 
 
 MARGIN = 1.1  # the shadow's own error is below a tenth of the main run's: e ≤ 1.1·d
+FINER = 8  # the shadow's step over an order-4 main method's
 
 
 def shadow_scene(scene, h: float):
-    """The shadow's settings, in f64: RK4 at the main step, or an order-4 main method at a quarter of it."""
-    method = scene.integrator.method
-    high = integrators.METHOD[method].order >= 4
-    if not high and "rk4" in registry.get(scene.system).METHODS:
-        method = "rk4"
-    return scene.replace(integrator={"method": method, "dt": h / 4 if high else h, "precision": "f64",
-                                     "allow_unstable": True})
+    """The shadow's settings: RK4 in f64 (run with compensated sums: trajectory) at the main step, or at a
+    quarter of it for an order-4 main method."""
+    high = integrators.METHOD[scene.integrator.method].order >= 4
+    return scene.replace(integrator={"method": "rk4", "dt": h / FINER if high else h, "precision": "f64",
+                                     "trig": "inline", "allow_unstable": True})
 
 
-def trajectory(scene, indices: np.ndarray, arch: str, threads=None, frames: int | None = None):
+def trajectory(scene, indices: np.ndarray, arch: str, threads=None, frames: int | None = None,
+               compensated: bool = False):
     """The states (frames, len(indices), D) of those pendulums at every frame time (the first `frames`
     frames, or all), in float64, a blow-up among them as NaN/inf; and the system that ran them."""
-    run = Run(scene, arch, threads, subset=indices)
+    run = Run(scene, arch, threads, subset=indices, compensated=compensated)
     frames = scene.frames if frames is None else min(frames, scene.frames)
     return record(run, frames), run.sim
 
@@ -160,16 +168,13 @@ def certify(scene, arch: str = "cpu", threads=None, indices: np.ndarray | None =
     shadow_first = scene.integrator.precision != "f64"  # then the render's own init comes last
     if shadow_first:
         plan = registry.get(scene.system)(scene, subset=indices[:1])  # the step only
-        ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads)
+        ref, _ = trajectory(shadow_scene(scene, plan.h), indices, arch, threads, compensated=True)
     run = Run(scene, arch, threads, subset=indices)
     main = record(run, scene.frames, watch=True)  # a blow-up, not an untrue run: the watchdog says so
     sim = run.sim
     shadow = shadow_scene(scene, sim.h)
-    if not shadow_first and shadow.integrator.method == scene.integrator.method:
-        sim.restart()  # the same method in f64 at a quarter of the step: the same compiled kernel
-        ref = record(run, scene.frames, 4 * sim.substeps, sim.h / 4)
-    elif not shadow_first:
-        ref, _ = trajectory(shadow, indices, arch, threads)
+    if not shadow_first:
+        ref, _ = trajectory(shadow, indices, arch, threads, compensated=True)
     tol = scene.integrator.tolerance
     errors = MARGIN * sim.deviation(main, ref) / tol
     errors[~np.isfinite(errors)] = np.inf  # a blow-up is as unfaithful as it gets

@@ -117,13 +117,14 @@ class Pilot:
     def __init__(self, scene, arch, threads, ref_dt: float, need: float):
         self.scene, self.arch, self.threads = scene, arch, threads
         self.indices = certify.subsample(scene.pendulums.count, PILOT)
-        ref = _with(scene, setting("rk4", ref_dt, "f64"))
+        # compensated sums, as the certificate's shadow: plain, its round-off grew like the finest candidate's
+        ref = scene.replace(integrator={**setting("rk4", ref_dt, "f64"), "trig": "inline", "allow_unstable": False})
         # As far as the target needs: a pilot's outcome is known there.
         self.frames = min(scene.frames, math.ceil(need * scene.video.fps) + 2)
         # How far a pilot looks: a pendulum still faithful there is faithful "until" here, no further (the
         # certificate's whole duration where the pilot runs to the end), so no report claims what no run saw.
         self.horizon = scene.video.duration if self.frames == scene.frames else (self.frames - 1) / scene.video.fps
-        self.ref, _ = certify.trajectory(ref, self.indices, arch, threads, self.frames)
+        self.ref, _ = certify.trajectory(ref, self.indices, arch, threads, self.frames, compensated=True)
         self.runs = {}
 
     def median_until(self, s: dict, need: float) -> float:
