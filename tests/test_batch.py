@@ -253,3 +253,38 @@ def test_bad_jobs_is_a_usage_error(capsys):
     with pytest.raises(SystemExit) as e:
         main(["batch", "--jobs", "0"])
     assert e.value.code == 2 and "positive integer" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("sets, needle", [
+    (["effects=[\"rods\",\"bobs\",\"lyapunov\"]", "video.duration=0.05"], "the spectrum's error needs at least"),
+    (["video.height=36"], "leaves panels 6 px high"),
+])
+def test_a_batch_refuses_before_any_work_what_render_refuses(sets, needle, tmp_path, capsys):
+    """batch checked the folder and the budget only: a spectrum too short for its error was rendered with NaN in
+    metadata.json (not JSON), and a comparison's too-small panels failed in a worker after its simulation."""
+    preset = "compare_methods" if "panels" in needle else "classic"
+    base = ["video.width=64", "video.height=36", "video.duration=0.05", *sets]
+    out = tmp_path / "out"
+    assert main(["batch", preset, *(a for s in base for a in ("--set", s)), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0] and not out.exists(), err
+
+
+def test_a_batch_whose_own_files_cannot_be_written_is_refused_before_rendering(tmp_path, capsys):
+    """OUT/index.html a folder: every render ran, then the batch failed writing its gallery."""
+    (tmp_path / "index.html").mkdir()
+    assert main(["batch", "classic", "--set", "video.duration=0.05", "--out", str(tmp_path), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "index.html: is a folder" in err[0]
+    assert [p.name for p in tmp_path.iterdir()] == ["index.html"]
+
+
+@pytest.mark.parametrize("name", ["index.html", "batch.json", "compare", "bench"])
+def test_a_scene_may_not_take_a_name_that_out_itself_holds(name, tmp_path, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["render", "classic", "--name", name, "--out", str(tmp_path)])
+    assert e.value.code == 2 and "what OUT itself holds" in capsys.readouterr().err
+    (tmp_path / "p.toml").write_text(f'name = "{name}"\n' + (Path(__file__).parents[1] / "presets/classic.toml").read_text())
+    assert main(["render", str(tmp_path / "p.toml"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "name: " in err[0] and not (tmp_path / "out").exists()

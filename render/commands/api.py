@@ -95,9 +95,10 @@ def check_panels(scene) -> None:
                              f"shared clock; each needs at least {PANEL_MIN}: use a larger video")
 
 
-def check_render(scene_list, out: Path, tiled: str | None = None) -> None:
-    """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder), a
-    scene over the budget, or with `tiled` (the option asking for it) one that cannot be rendered in tiles."""
+def check_render(scene_list, out: Path, tiled: str | None = None, files: tuple[str, ...] | None = None) -> None:
+    """Refuse (SceneError) before any work: an output that cannot be written (options.check_out_folder, with
+    its `files`), a scene over the budget, or with `tiled` (the option asking for it) one that cannot be
+    rendered in tiles. Every command that renders or plays a scene (render, batch, compare, show) asks this."""
     out = Path(out)
     for scene in scene_list:
         if scene.compare:
@@ -105,7 +106,7 @@ def check_render(scene_list, out: Path, tiled: str | None = None) -> None:
         if tiled:
             from ..video import tiled as tiling
             tiling.check(scene, tiled)
-        check_out_folder(scene, out)
+        check_out_folder(scene, out, files)
         if scene.has("lyapunov"):  # an integrator with no tangent map, too few frames for the error
             from ..trust import lyapunov
             lyapunov.check(scene, lyapunov.default_pendulums(scene))

@@ -18,12 +18,11 @@ import time
 from pathlib import Path
 
 from ..config import budget
-from . import gallery
+from . import api, gallery
 from .batch_plan import expand_refs, parse_sweeps, plan
-from ..physics import registry
 from ..video.atomic import output_dir, write_atomic
 from ..errors import BatchError, SceneError
-from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, check_writable,
+from ..config.options import (add_budget, add_common, add_quality, budgeted, check_replaceable, check_writable,
                               out_path, positive_int, progress_wanted, thread_count, usable_cores)
 from ..video.tiled import close, connect, env_address, quiet, scheduler_address
 from ..video.version import __version__
@@ -174,6 +173,8 @@ def run(args) -> int:
     address = scheduler_address(args.scheduler) if args.scheduler is not None else env_address()
     jobs_plan = plan(expand_refs(args.presets), args.overrides, parse_sweeps(args.sweep), args.quality)
     check_writable(args.out)
+    for own in ("batch.json", "index.html"):  # written last, after every render: refused before the first
+        check_replaceable(args.out / own)
     out_root = args.out.resolve()  # absolute: Dask workers may run elsewhere with another cwd
     cores = usable_cores()
     rows: dict[str, dict] = {}
@@ -182,8 +183,7 @@ def run(args) -> int:
         if "scene" in job:
             try:  # where each render writes and what it costs, refused before any work as a bad preset is
                 job["scene"] = budgeted(job["scene"], args)
-                check_out_folder(job["scene"], out_root)  # e.g. OUT/NAME a symlink leading out of OUT
-                budget.check(job["scene"], registry.get(job["scene"].system), out_root)
+                api.check_render([job["scene"]], out_root)  # what `render` refuses, e.g. OUT/NAME a symlink
             except SceneError as e:
                 job["error"] = str(e)
         if "error" in job:

@@ -27,9 +27,10 @@ import sys
 import time
 from pathlib import Path
 
+from . import api
 from ..video import pipeline
 from ..config import budget
-from ..config.options import (add_budget, add_common, add_quality, budgeted, check_out_folder, out_path, output_name,
+from ..config.options import (add_budget, add_common, add_quality, budgeted, out_path, output_name,
                               thread_count)
 from ..config.scene import load
 from .player import KEYS_HELP, FrameSource, Player, png_bytes, saves_to, say  # noqa: F401 - png_bytes: for tests
@@ -116,7 +117,7 @@ def run(args) -> int:
     loaded = load(args.preset, args.overrides, args.quality)
     scene = output_name(loaded, bool(args.overrides or args.quality))
     scene = budgeted(scene, args)
-    check_out_folder(scene, args.out, files=())
+    api.check_render([scene], args.out, files=())  # what `render` refuses before any work, `show` refuses too
     # what `render` refuses, `show` refuses too: it simulates and certifies the same (a comparison records its
     # variants whole before the window opens), so memory and time are those of a render
     estimate = budget.check_run([scene], args.out, say=False)

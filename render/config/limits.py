@@ -40,6 +40,9 @@ MAX_PIXELS = 3840 * 2160
 # characters keep every one of them far below the 255-byte limit of common file systems.
 NAME_MAX = 100
 NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.\-]*"  # letters, digits, _ . -, not starting with . or -
+# What OUT itself holds (the gallery, the batch's record, comparisons' and the bench's folders): a scene of
+# that name would put its folder where they go, and the next batch or bench would fail after its work
+RESERVED_NAMES = ("index.html", "batch.json", "compare", "bench")
 DESCRIPTION_MAX = 1000  # free text shown in the gallery; longer is almost surely a mistake (a pasted file)
 # Common [pendulums] keys (each system declares its own in keys.py). Angles wrap, so beyond ±1000 rad a
 # spread only loses resolution (f64 resolves ~1e-13 rad there); gravity up to 1e4 m/s² (1000 g) and

@@ -93,11 +93,14 @@ def add_name(p):
 
 def folder_name(text: str) -> str:
     """An argparse type: a name a scene may have (limits.py), so it is safe as a folder and file name."""
-    from .limits import NAME_MAX, NAME_PATTERN
+    from .limits import NAME_MAX, NAME_PATTERN, RESERVED_NAMES
 
     if not re.fullmatch(NAME_PATTERN, text) or len(text) > NAME_MAX:
         raise argparse.ArgumentTypeError(f"must be letters, digits, _ . - (not first . or -), at most {NAME_MAX} "
                                          f"characters, got {text[:40]!r}")
+    if text in RESERVED_NAMES:
+        raise argparse.ArgumentTypeError(f"{text!r} is what OUT itself holds ({', '.join(RESERVED_NAMES)}): "
+                                         f"choose another")
     return text
 
 

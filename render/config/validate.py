@@ -18,8 +18,8 @@ from ..trust.levels import LEVELS
 from .checks import Checker, clip, hint, show_key, tname
 from .limits import (AXIS_MAX, DAMPING_MAX, DESCRIPTION_MAX, EFFECTS, F32_SIZE_MAX, F32_SIZE_MIN, FORMATS, FRACTALS,
                      GRAVITY_MAX, LAYOUTS, LINK_EFFECTS, MAP_AXES, MAP_DEFAULTS, MAX_MAP_PENDULUMS, MAX_PENDULUMS,
-                     MAX_PIXELS, METHODS, NAME_MAX, NAME_PATTERN, PALETTES, PRECISIONS, SAMPLES, SPREAD_MAX, SYSTEMS,
-                     TRIGS)
+                     MAX_PIXELS, METHODS, NAME_MAX, NAME_PATTERN, PALETTES, POINCARE_MIN, PRECISIONS, RESERVED_NAMES,
+                     SAMPLES, SPREAD_MAX, SYSTEMS, TRIGS)
 from .vary import PANEL_MIN, VARIANTS, VARYING, Twice, dotted, frozen, plain, vary_refusal
 
 
@@ -31,6 +31,8 @@ class Validator(Checker):
         name = self.text(d["name"], "name", NAME_MAX)
         if not re.fullmatch(NAME_PATTERN, name):
             self.fail("name", f"must be a file-name-safe string (letters, digits, _ . -), got {clip(repr(name))}")
+        if name in RESERVED_NAMES:
+            self.fail("name", f"{name!r} is what OUT itself holds ({', '.join(RESERVED_NAMES)}): choose another")
         description = self.text(d["description"], "description", DESCRIPTION_MAX)
         system = self.choice(d["system"], "system", SYSTEMS)
         video = self.video(d)
