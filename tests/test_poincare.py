@@ -126,6 +126,21 @@ def test_the_section_needs_two_link_angles():
         load("compare_methods", ['effects=["rods", "poincare"]'])
 
 
+@pytest.mark.parametrize("size, effects, ok", [((64, 36), '["rods", "poincare"]', False),
+                                                ((190, 96), '["rods", "poincare"]', False),
+                                                ((192, 96), '["rods", "poincare"]', True),
+                                                ((96, 94), '["poincare"]', False), ((96, 96), '["poincare"]', True)])
+def test_the_section_panel_has_a_least_size_and_draws_from_there(size, effects, ok):
+    """Below it the panel's labels fell outside the frame: an IndexError after the simulation (exit 1)."""
+    sets = [f"video.width={size[0]}", f"video.height={size[1]}", "video.duration=0.05", f"effects={effects}"]
+    if not ok:
+        with pytest.raises(SceneError, match="'poincare' draws its section in a panel"):
+            load("classic", sets)
+        return
+    src = pipeline.open_source(load("classic", sets))
+    assert src.next_frame().shape == (size[1], size[0], 3)
+
+
 def test_a_shell_at_rest_and_the_effect_on_springs_exit_2_with_one_line(tmp_path):
     springs = ["--set", 'system="elastic"', "--set", "pendulums.stiffness=1e3",
                "--set", 'effects=["springs", "poincare"]']

@@ -56,3 +56,6 @@ DAMPING_MAX = 1e3
 F32_SIZE_MIN, F32_SIZE_MAX = 1e-3, 1e3
 
 REQUIRED = object()  # schema default for keys a preset must state: the scene is ambiguous without them
+# The Poincaré panel's least side (render/draw/section.py): its 6x13 title, ticks and labels take 63 px of the
+# height and 62 of the width around the plot, which keeps 33 px
+POINCARE_MIN = 96

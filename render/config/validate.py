@@ -57,6 +57,11 @@ class Validator(Checker):
         if "lyapunov" in effects and (d.get("compare") is not None or fractal is not None):
             self.fail("effects", "'lyapunov' measures the certified pendulums of one fan beside the certificate; "
                       "for a comparison or a map, run `pendulum lyapunov` on the variant or pixel instead")
+        if "poincare" in effects:  # its panel (render/draw/section.py): title, ticks and labels around a plot
+            panel = video["width"] // 2 if any(e in keys.DRAWN for e in effects) else video["width"]
+            if min(panel, video["height"]) < POINCARE_MIN:
+                self.fail("effects", f"'poincare' draws its section in a panel of {panel}x{video['height']} px, "
+                          f"and needs {POINCARE_MIN} px each way (video.width {2 * POINCARE_MIN} beside the pendulums)")
         if "poincare" in effects and d.get("compare") is not None:
             self.fail("compare", "a Poincaré section is drawn from crossings found as the pendulums are stepped, "
                       "which a comparison's panels do not record; render each variant with --set instead")
