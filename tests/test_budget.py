@@ -289,6 +289,22 @@ def test_the_rates_in_out_bench_are_read_when_present(tmp_path):
     assert code == 2 and "rates from" in lines[0] and "bench/rates.json" in lines[0]
 
 
+@pytest.mark.parametrize("link", ["bench", "bench/rates.json"])
+def test_rates_behind_a_symlink_out_of_out_are_not_read(tmp_path, link):
+    """Tiny rates outside OUT, reached through OUT/bench or OUT/bench/rates.json as a symlink, let a run over
+    its budget start: nothing is read outside the output folder."""
+    outside, out = tmp_path / "outside", tmp_path / "out"
+    outside.mkdir()
+    (outside / "rates.json").write_text(json.dumps({"fixed_s": 1e-9, "frame_s": 1e-9}))
+    (out / "bench").mkdir(parents=True)
+    if link == "bench":
+        (out / "bench").rmdir()
+        (out / "bench").symlink_to(outside)
+    else:
+        (out / "bench" / "rates.json").symlink_to(outside / "rates.json")
+    assert estimate.load_rates(out) == (RATES, "built-in rates")
+
+
 @pytest.mark.parametrize("text", [b"not json", b"[1, 2]", b'{"steps_per_s": [1]}', b'{"fixed_s": -1}',
                                   b'{"fixed_s": NaN, "frame_s": "fast", "draw_link_s": true, "gif_pixel_s": 1e400}',
                                   b"\xff\xfe\x00", b""])

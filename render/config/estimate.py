@@ -97,8 +97,11 @@ def load_rates(out: Path | None) -> tuple[dict, str]:
     JSON table: a malformed file is ignored, never an error)."""
     rates = json.loads(json.dumps(RATES))
     path = Path(out) / RATES_FILE if out is not None else None
-    try:  # read as a preset is: a FIFO or /dev/zero there must not hang the check or fill memory
-        given = json.loads(read_regular(path, RATES_MAX_BYTES)) if path is not None else None
+    # Inside OUT only: a symlink there (OUT/bench or the file) may lead out of it, and rates read from elsewhere
+    # could lift the budget's refusal. Read as a preset is: a FIFO or /dev/zero must not hang the check.
+    inside = path is not None and not path.parent.is_symlink()  # OUT/bench; the file is opened O_NOFOLLOW
+    try:
+        given = json.loads(read_regular(path, RATES_MAX_BYTES, follow=False)) if inside else None
     except (OSError, ValueError):  # absent, unreadable, not a regular file (Refused), not UTF-8 or not JSON
         given = None
     used = 0
