@@ -130,6 +130,9 @@ def test_a_bad_scheduler_from_the_environment_is_refused_before_the_first_render
     refused(r, tmp_path, "$DASK_SCHEDULER_ADDRESS 'tcp://host:abc'", "expected an address")
     r = cli(tmp_path, "render", "fractal_flip", *SMALL, "--scheduler", "", "--out", out)
     refused(r, tmp_path, "--scheduler ''")
+    for bare in ("localhost", "tcp://[::1]"):  # no port: Client failed after 20 s, with a traceback
+        r = cli(tmp_path, "render", "fractal_flip", *SMALL, "--scheduler", bare, "--out", out)
+        refused(r, tmp_path, f"--scheduler {bare!r}", "expected an address")
     r = cli(tmp_path, "render", "classic", *SMALL, "--out", "")
     assert r.returncode == 2 and "--out: must name a folder or file" in r.stderr, r.stderr
     assert not out.exists() and tree(tmp_path) == []

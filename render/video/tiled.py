@@ -36,11 +36,11 @@ def scheduler_address(text: str | None, what: str = "--scheduler") -> str | None
     if text is None:
         return None
     address = text if "://" in text else f"tcp://{text}"
-    # host, [IPv6] or host:port; the port, when given, a number Dask can connect to (a bad one made Client
-    # raise in a background thread and hang)
-    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+)(?::([^\s/]*))?", address)
+    # host:port or [IPv6]:port; the port a number Dask can connect to (a bad one made Client raise in a
+    # background thread and hang; none, "missing port number" after Client's 20 s timeout, with a traceback)
+    m = re.fullmatch(r"(tcp|tls|ws|wss|ucx|inproc)://(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):([^\s/]*)", address)
     port = m and m.group(3)
-    if not m or (port is not None and not (port.isascii() and port.isdigit() and 0 < int(port) < 65536)):
+    if not m or not (port.isascii() and port.isdigit() and 0 < int(port) < 65536):
         raise SceneError(f"{what} {text!r}: expected an address like tcp://host:8786 (a port from 1 to 65535)")
     return address
 
