@@ -12,7 +12,7 @@ from render.video import pipeline
 from render.physics import reference, registry
 from render.physics.stepper import Run
 from render.config.scene import load
-from render.errors import SimulationError
+from render.errors import SceneError, SimulationError
 
 
 def reference_until(scene, indices):
@@ -270,3 +270,15 @@ def test_an_unreachable_level_says_so_and_renders_the_most_faithful(capsys):
     best = max(t["median_until_s"] for t in report["pilots"]["tried"])
     assert [t for t in report["pilots"]["tried"] if t["median_until_s"] == best][0]["method"] == \
         chosen_scene.integrator.method
+
+
+@pytest.mark.parametrize("sets, values", [(["integrator.method=rk2"], {}), (["integrator.dt=5e-4"], {}),
+                                          ([], {"integrator": {"precision": "f32"}}), ([], {"integrator.dt": 1e-3})])
+def test_a_quality_level_beside_an_integrator_setting_it_would_replace_is_refused(sets, values):
+    """--quality draft --set integrator.method=rk2 ran draft's rk4 f32 and listed rk2 in the metadata's
+    overrides. The preset's own [integrator] is what a level replaces; other integrator keys stay."""
+    from render.commands import api
+    with pytest.raises(SceneError, match="chooses the integrator's method, dt and precision"):
+        api.load("classic", *sets, quality="draft", **values)
+    assert api.load("classic", "integrator.tolerance=1e-4", quality="draft").integrator.tolerance == 1e-4
+    assert load("rigid_chaos", quality="high").quality == "high"  # its preset states method, dt and precision

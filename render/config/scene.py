@@ -245,7 +245,20 @@ def load(ref: str, overrides: list[str] | tuple[str, ...] = (), quality: str | N
         _apply_override(raw, key.split("."), value, src, how="")
     given = ([f"quality={quality}"] if quality is not None else []) + list(overrides)
     given += [f"{key}={json.dumps(value)}" for key, value in (values or {}).items()]  # JSON's scalars are TOML's
+    _quality_or_integrator(raw.get("quality"), overrides, values, src)
     return dataclasses.replace(from_dict(raw, src), overrides=tuple(given))
+
+
+def _quality_or_integrator(level, overrides, values: dict | None, src: str) -> None:
+    """A quality level beside integrator.method, .dt or .precision given by --set (or the API's values): the
+    level's choice had replaced them silently. The preset's own [integrator] is what a level overrides."""
+    keys = [item.split("=", 1)[0].strip() for item in overrides]
+    for key, value in (values or {}).items():
+        keys += [f"{key}.{k}" for k in value] if isinstance(value, dict) else [key]
+    for key in keys if level is not None else ():
+        if key in ("integrator.method", "integrator.dt", "integrator.precision"):  # what the pilots choose
+            raise SceneError(f"{src}: --set {key}: quality {level!r} chooses the integrator's method, dt and "
+                             f"precision; give the quality level or the {key}, not both")
 
 
 def parse_override(item: str, src: str = "--set") -> tuple[list[str], object]:
