@@ -46,6 +46,7 @@ def test_damped_sum_is_minus_d_times_c_at_every_duration():
     assert np.abs(sums + 0.30).max() < 1e-3 * 0.30, np.abs(sums + 0.30).max()
     for row in lyapunov.summary(run, scene.pendulums.damping):
         assert row["checks"]["expected_sum"] == pytest.approx(-0.30)
+        assert row["checks"]["expected_pair_sum"] == pytest.approx(-0.15)  # conformally symplectic: each pair −c
         assert abs(row["checks"]["sum_defect"]) < 1e-3 * 0.30
         assert row["exponents"] == sorted(row["exponents"], reverse=True)
 

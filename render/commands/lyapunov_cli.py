@@ -27,7 +27,7 @@ numerical flow (Taichi forward-mode AD of one frame of the integrator) and are r
 every frame (Benettin). Each exponent is printed with its error: 2 standard errors by batch means of the
 per-frame log growth rates over the run's last half, plus how far the running average moved over it (the
 start's 1/t bias). Checks: the sum of the exponents is -D*c at any duration (c = pendulums.damping, D the
-coordinates; 0 undamped), and each pair λ_i + λ_(2D+1-i) tends to 0. λ1 predicts how long a render stays
+coordinates; 0 undamped), and each pair λ_i + λ_(2D+1-i) tends to -c. λ1 predicts how long a render stays
 true: ln(tolerance / e0) / λ1 from the error e0 after the first frame, printed beside the faithful time the
 certificate measures. Default pendulums: the certificate's, thinned to 8."""
 
@@ -47,7 +47,8 @@ def add_parser(sub):
                        description="Measure the full Lyapunov spectrum (2D exponents: 4 for a double pendulum, 6 "
                                    "for the triple, 8 for the elastic one) of chosen pendulums of PRESET; print "
                                    "each with its error and checks, and write lyapunov.json and lyapunov.png "
-                                   "into OUT/NAME/.")
+                                   "into OUT/NAME/ (OUT/NAME__<hash>/ with --set, OUT/compare/NAME/ for a "
+                                   "comparison's preset).")
     p.add_argument("preset", metavar="PRESET", help="a name from presets/ or a path to a .toml file")
     add_common(p)
     add_budget(p)
@@ -97,4 +98,4 @@ def line(row: dict) -> str:
     pred = "—" if f["predicted_horizon_s"] is None else f"{f['predicted_horizon_s']:.2f} s"
     until = f"{f['faithful_until_s']:.2f} s" + (" (the end)" if f["faithful_through_the_end"] else "")
     return (f"pendulum {row['pendulum']}: λ = {lam} 1/s | sum {c['sum']:+.3e} (expected {c['expected_sum']:+g}) | "
-            f"pairs {pairs} | λ1 predicts faithful for {pred}, the certificate measures {until}")
+            f"pairs {pairs} (tending to {c['expected_pair_sum']:+g}) | λ1 predicts faithful for {pred}, the certificate measures {until}")

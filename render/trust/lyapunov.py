@@ -9,7 +9,8 @@ The checks it reports, per pendulum:
 - the sum of the exponents, (1/T)·ln |det DΦ_T|, which for this project's damping (−c·p on every one of the
   D coordinates) is −D·c exactly, at any duration; its defect is the numerical flow's volume error (RK4 at
   dt 1e-3: below 1e-10 1/s on classic and damped_heavy, tests/test_lyapunov.py);
-- the pairs' sums λ_i + λ_{2D+1−i}, which a Hamiltonian flow makes 0 in the long run only.
+- the pairs' sums λ_i + λ_{2D+1−i}, which tend to −c in the long run only: 0 for a Hamiltonian flow, and −c
+  for one damped by −c·p on every coordinate, whose flow is conformally symplectic (Dressler 1988).
 
 Error estimate: batch means of the per-frame rates r_f = ln |R_ii| / (frame time). The last half of the run
 (past the tangent basis's alignment transient) is cut into BLOCKS blocks of L frames; their means' standard
@@ -160,7 +161,8 @@ def summary(run: dict, damping: float) -> list[dict]:
                     "frames": len(r),
                     "checks": {"sum": float(lam.sum()), "expected_sum": 0.0 - D * damping,
                                "sum_defect": float(lam.sum() + D * damping),
-                               "pair_sums": pairs.mean(0).tolist(), "pair_errors": error(pairs).tolist()},
+                               "pair_sums": pairs.mean(0).tolist(), "pair_errors": error(pairs).tolist(),
+                               "expected_pair_sum": 0.0 - damping},
                     "columns": order.tolist()})  # the Benettin columns, as sorted
     return out
 
