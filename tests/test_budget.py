@@ -350,7 +350,11 @@ def test_the_substeps_counter_and_a_subnormal_dt():
     which must still be a refusal, not an OverflowError."""
     msg = refusal(make_scene(integrator={"dt": 1e-11}, video={"fps": 10, "duration": 0.2}))
     assert "substeps per frame of 1e-11 s exceed the step counter's limit of 2147483647" in msg
-    assert "integrator.dt" in refusal(make_scene(integrator={"dt": 5e-324}, video=SMALL))
+    assert "integrator.dt: 4.94066e-324 s is too small to step by" in refusal(make_scene(integrator={"dt": 5e-324},
+                                                                                         video=SMALL))
+    # the count in a line one reads: it was 2**64 made up for the subnormal, and 300 digits for 1e-300
+    assert "dt too small: about 1e+299 substeps per frame" in refusal(make_scene(integrator={"dt": 1e-300},
+                                                                                      video=SMALL))
 
 
 def test_many_pendulums_for_long_are_refused_naming_count_and_duration():

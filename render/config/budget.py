@@ -75,7 +75,10 @@ def check(scene, system, out: Path | None, simulate: bool = False):
         if dt != "auto":
             per_frame = variant.video.fps * dt
             ratio = 1.0 / per_frame if per_frame > 0 else math.inf
-            substeps = max(1, math.ceil(ratio - 1e-9)) if math.isfinite(ratio) else 2 ** 64
+            if not math.isfinite(ratio):
+                raise SceneError(f"{variant.source}: integrator.dt: {dt:g} s is too small to step by: a frame of "
+                                 f"1/{variant.video.fps} s would take infinitely many; use a larger integrator.dt")
+            substeps = max(1, math.ceil(ratio - 1e-9))
             check_substeps(variant, substeps, 1.0 / (variant.video.fps * substeps))
     rates, source = estimates.load_rates(out)
     est = _estimate(scene, json.dumps(rates, sort_keys=True), source, simulate)

@@ -86,7 +86,8 @@ def check_substeps(scene, substeps: int, h: float) -> None:
     """Refuse substeps per frame beyond the kernel's i32 counter: beyond it the count wrapped to 0 and the video
     froze (render/config/budget.py refuses long runs by their time)."""
     if substeps > SUBSTEP_LIMIT:
-        raise SceneError(f"{scene.source}: integrator.dt: dt too small: {substeps} substeps per frame of {h:.3g} s "
+        many = f"{substeps}" if substeps < 10 ** 15 else f"about {float(substeps):.3g}"  # not 300 digits
+        raise SceneError(f"{scene.source}: integrator.dt: dt too small: {many} substeps per frame of {h:.3g} s "
                          f"exceed the step counter's limit of {SUBSTEP_LIMIT}; use a larger integrator.dt")
 
 
