@@ -247,7 +247,8 @@ def md_text(rows, energy, quick: bool, note: str = "") -> str:
 def add_parser(sub):
     p = sub.add_parser("accuracy", help="measure error vs. time of every integrator; charts and tables",
                        description="Work-precision and energy-drift charts per system, f32-vs-f64 divergence, "
-                                   "and accuracy.csv/.md, measured against a scipy DOP853 reference.")
+                                   "accuracy.csv/.md, summary.md, and for the flagship quality.md and "
+                                   "faithful_*.png, measured against a scipy DOP853 reference.")
     p.add_argument("--system", choices=(*registry.names(), "all"), default="all",
                    help=f"which system to measure (default: all); the system of {CHAOS} also draws divergence.png")
     p.add_argument("--out", type=out_path, default=Path("out/accuracy"),

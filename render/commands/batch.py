@@ -37,7 +37,8 @@ def add_parser(sub):
                                    "`render`, skipping up-to-date outputs; print a summary, write "
                                    "OUT/batch.json and the gallery OUT/index.html.")
     b.add_argument("presets", nargs="*", metavar="PRESET|GLOB",
-                   help="preset names, .toml paths or globs of either (default: every file in presets/)")
+                   help="preset names, .toml paths or globs of either (default: every preset on the search path, "
+                        "$PENDULUM_PRESETS then presets/)")
     add_common(b)
     b.add_argument("--out", type=out_path, default=Path("out"), help="output root (default: out)")
     b.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="J",
@@ -47,7 +48,8 @@ def add_parser(sub):
                         "--out must then be a directory the workers share")
     b.add_argument("--force", action="store_true", help="render again even when the output is up to date")
     b.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2,...",
-                   help="render one variant per value (OUT/NAME__KEY_VALUE); repeat for a grid")
+                   help="render one variant per value (OUT/NAME__KEY_VALUE, then __<hash> with --set); repeat for "
+                        "a grid")
     add_quality(b)
     add_budget(b)
     b.add_argument("--threads", type=thread_count, default=None,

@@ -59,7 +59,8 @@ def add_parser(sub):
                                    "the machine's peak flop rate), drawing and encoding fps, the HUD, an "
                                    "end-to-end render against the encode-only floor, the matplotlib peer, and "
                                    "the fractal maps, each ratio over interleaved rounds with its spread; "
-                                   "write OUT/report.md, OUT/report.json and OUT/rates.json: this machine's rates, "
+                                   "write OUT/report.md, OUT/report.json, OUT/targets.md (the targets' table) and "
+                                   "OUT/rates.json: this machine's rates, "
                                    "from which `render --out DIR` estimates its run time when they are "
                                    "DIR/bench/rates.json (the default out/bench serves the default out).")
     p.add_argument("--quick", action="store_true", help="small N ladder, short videos, 2 rounds (a few minutes)")
