@@ -36,6 +36,12 @@ def reference_until(scene, indices):
     return np.array(until)
 
 
+def test_metadata_rounds_each_pendulums_faithful_time_down():
+    """16/60 s was written 0.2667, later than the pendulum was faithful (an independent review)."""
+    cert = certify.Certificate({}, 1e-3, "rad", np.arange(3), np.array([16 / 60, 0.35, 20.0]), 20.0, 0.0, np.zeros(3))
+    assert cert.to_dict()["until_s"] == [0.2666, 0.35, 20.0]
+
+
 def test_faithful_times_is_the_last_frame_before_the_first_error_over_one():
     errors = np.array([[0.0, 0.0, 0.0], [0.9, 1.5, 0.1], [1.0, 0.2, 3.0], [0.3, 0.1, 0.2]])  # 4 frames, 3 pendulums
     assert certify.faithful_times(errors, 10, 0.4).tolist() == [0.4, 0.0, 0.1]  # 1.0 is within: "exceeds"
