@@ -116,7 +116,7 @@ def test_a_large_fan_is_certified_whole_as_a_histogram():
     d = cert.to_dict()
     assert d["certified"] == 1000 and d["pendulums"]["first"] == 0 and d["pendulums"]["last"] == 999
     assert sum(d["until_s_histogram"]["counts"]) == 1000
-    assert d["shadow"] == {"method": "rk4", "dt": pytest.approx(1 / 10 / 100 / 4), "precision": "f64"}
+    assert d["shadow"] == {"method": "rk4", "dt": pytest.approx(1 / 10 / 100 / certify.FINER), "precision": "f64"}
 
 
 def test_a_long_videos_large_fan_is_certified_on_as_many_as_fit():

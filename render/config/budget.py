@@ -76,7 +76,8 @@ def check(scene, system, out: Path | None, simulate: bool = False):
             per_frame = variant.video.fps * dt
             ratio = 1.0 / per_frame if per_frame > 0 else math.inf
             if not math.isfinite(ratio):
-                raise SceneError(f"{variant.source}: integrator.dt: {dt:g} s is too small to step by: a frame of "
+                # no number: once Taichi has started, the FPU flushes subnormals, formatting's arithmetic too
+                raise SceneError(f"{variant.source}: integrator.dt: too small to step by (subnormal): a frame of "
                                  f"1/{variant.video.fps} s would take infinitely many; use a larger integrator.dt")
             substeps = max(1, math.ceil(ratio - 1e-9))
             check_substeps(variant, substeps, 1.0 / (variant.video.fps * substeps))
