@@ -17,16 +17,16 @@ def _g(x) -> str:
 
 
 def until(t, duration) -> str:
-    """A faithful time: "the end" once it lasts the video, else its seconds ("8.70 s")."""
+    """A faithful time: "the end" once it lasts the video, else its seconds ("8.68 s")."""
     if not _number(t):
         return "?"
     return "the end" if _number(duration) and t >= duration else f"{t:.2f} s"
 
 
 def sentence(f: dict, duration, brief: bool = False) -> str:
-    """The certificate `f` of a video `duration` s long: "faithful until 8.70 s (median 12.25 s, 3 % through
+    """The certificate `f` of a video `duration` s long: "faithful until 8.68 s (median 12.24 s, 1 % through
     20 s) at 0.001 rad": until when the first and the median certified pendulum stay faithful, the share that
-    does to the end, and the tolerance. Brief, for a row headed "faithful": "until 8.70 s (median 12.25 s)
+    does to the end, and the tolerance. Brief, for a row headed "faithful": "until 8.68 s (median 12.24 s)
     at 0.001 rad"."""
     first, median = until(f.get("faithful_until_s"), duration), until(f.get("median_until_s"), duration)
     unit = f.get("unit")
