@@ -98,4 +98,5 @@ def line(row: dict) -> str:
     pred = "—" if f["predicted_horizon_s"] is None else f"{f['predicted_horizon_s']:.2f} s"
     until = f"{f['faithful_until_s']:.2f} s" + (" (the end)" if f["faithful_through_the_end"] else "")
     return (f"pendulum {row['pendulum']}: λ = {lam} 1/s | sum {c['sum']:+.3e} (expected {c['expected_sum']:+g}) | "
-            f"pairs {pairs} (tending to {c['expected_pair_sum']:+g}) | λ1 predicts faithful for {pred}, the certificate measures {until}")
+            f"pairs {pairs} (tending to {c['expected_pair_sum']:+g}) | λ1 predicts faithful for {pred}, the "
+            f"certificate measures {until}")

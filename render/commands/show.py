@@ -117,9 +117,9 @@ def run(args) -> int:
     loaded = load(args.preset, args.overrides, args.quality)
     scene = output_name(loaded, bool(args.overrides or args.quality))
     scene = budgeted(scene, args)
-    api.check_render([scene], args.out, files=())  # what `render` refuses before any work, `show` refuses too
     # what `render` refuses, `show` refuses too: it simulates and certifies the same (a comparison records its
-    # variants whole before the window opens), so memory and time are those of a render
+    # variants whole before the window opens), so panels, spectra, memory and time are those of a render
+    api.check_render([scene], args.out, files=())
     estimate = budget.check_run([scene], args.out, say=False)
     suggest = render_command(args)
     probe = check_display(suggest)  # before any compiling: a missing display fails at once, its one line alone

@@ -107,8 +107,9 @@ def add_compensated(x, dx, carry):
     the sum lost. Over the 10^5-10^6 steps of a run, plain sums let the state's rounding (half an ulp of the
     angle a step, biased alike in runs at other steps) grow to 1e-11 rad and more, and chaos grows it to the
     tolerance: an RK4 shadow at a quarter of the step then erred as much as the run it checks, and alike
-    (render/trust/certify.py).
-    Needs IEEE arithmetic (fast_math off, runtime.init), or (t − x) − y folds to 0."""
+    (render/trust/certify.py). Fast2Sum's carry is exact while |x| ≥ |dx|, which holds but where a velocity
+    crosses 0: there it errs by an ulp of the step's change, ~1e-18. Needs IEEE arithmetic (fast_math off,
+    runtime.init), or (t − x) − y folds to 0."""
     y = dx - carry
     t = x + y
     return t, (t - x) - y

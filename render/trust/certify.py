@@ -23,9 +23,10 @@ against a long-double reference).
 
 Both runs cover every pendulum while their states at every frame fit in CERTIFY_BYTES (every shipped preset's
 fan: rainbow_1000's first pendulum breaks at 6.70 s, where its 128 evenly spaced ones, as certified before,
-say 6.80 s; with the earlier shadow 6.72 and 7.60 s), else a subsample of as many as fit and at least SUBSAMPLE, evenly spaced over the fan (the ends
-included). They run before the render: pendulums are independent, so the certified pendulums' main run is the
-render's, and a render that would be untrue can stop before it writes anything.
+say 6.80 s; with the earlier shadow 6.72 and 7.60 s), else a subsample of as many as fit and at least
+SUBSAMPLE, evenly spaced over the fan (the ends included). They run before the render: pendulums are
+independent, so the certified pendulums' main run is the render's, and a render that would be untrue can stop
+before it writes anything.
 """
 from __future__ import annotations
 
