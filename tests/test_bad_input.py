@@ -144,3 +144,16 @@ def test_out_path_that_is_a_file(tmp_path, capsys):
     assert cli.main(["render", "classic", "--out", str(blocker), "--no-progress"]) == 2
     assert "not a writable directory" in capsys.readouterr().err
     assert blocker.read_text() == "x"
+
+
+@pytest.mark.parametrize("key, value", [("pendulums.spread", "0.1"), ("pendulums.gap", "1e-6"),
+                                        ("video.palette", '"rainbow"'), ("video.trail_seconds", "2")])
+def test_a_fans_key_in_a_map_is_refused_not_ignored(tmp_path, capsys, key, value):
+    """A map's pendulums are its pixels: these rendered the same bytes as without them, into a new folder."""
+    out = tmp_path / "out"
+    assert cli.main(["render", "fractal", "--set", f"{key}={value}", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{key}: applies to a fan, and does nothing in a map" in err[0] and not out.exists()
+    from render.config.scene import load
+    assert load("fractal", ["pendulums.spread=1e-4"]).fractal == "angles"  # at its default: what a map's dict holds
+    assert load("fractal").replace(video={"fps": 30}).video.palette == "fan"  # so a map's own dict round-trips

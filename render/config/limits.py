@@ -59,3 +59,6 @@ REQUIRED = object()  # schema default for keys a preset must state: the scene is
 # The Poincaré panel's least side (render/draw/section.py): its 6x13 title, ticks and labels take 63 px of the
 # height and 62 of the width around the plot, which keeps 33 px
 POINCARE_MIN = 96
+# Keys a fan uses and a map ignores (its pendulums are its pixels): refused in a map's preset unless at their
+# defaults, which a scene's own dict carries when it round-trips
+FAN_ONLY = (("pendulums", "spread"), ("pendulums", "gap"), ("video", "palette"), ("video", "trail_seconds"))

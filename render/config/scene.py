@@ -18,7 +18,7 @@ from .catalog import PRESET_DIR, PRESET_MAX_BYTES, list_presets, preset_path  # 
 from ..errors import SceneError
 from ..trust.levels import check_level
 from .checks import clip, hint
-from .limits import MAP_AXES, MAP_DEFAULTS, REQUIRED, SYSTEMS
+from .limits import FAN_ONLY, MAP_AXES, MAP_DEFAULTS, REQUIRED, SYSTEMS
 from .validate import Validator
 
 # Keys under [pendulums] that every system has; each system adds its own (System.preset_keys()).
@@ -309,6 +309,10 @@ def from_dict(raw: dict, src: str = "<scene>") -> Scene:
     known = isinstance(system, str) and system in SYSTEMS  # else build() names the bad value
     schema = {**SCHEMA, "pendulums": pendulum_keys(system)} if known else SCHEMA
     d = v.build(v.merge(raw, schema, ""))
+    for section, key in FAN_ONLY if d["fractal"] is not None else ():  # a map's pendulums are its pixels
+        if raw.get(section, {}).get(key, schema[section][key]) != schema[section][key]:
+            raise SceneError(f"{src}: {section}.{key}: applies to a fan, and does nothing in a map, whose "
+                             f"pendulums are its pixels (map.x, map.y); leave it out")
     scene = Scene(d["name"], d["description"], d["system"], d["effects"], Pendulums(d["pendulums"]),
                   Integrator(**d["integrator"]), Video(**d["video"]), d["quality"], d["fractal"], MapSpec(**d["map"]),
                   d["compare"], d["budget"], source=src)
