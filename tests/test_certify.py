@@ -72,20 +72,6 @@ def test_the_certificate_agrees_with_dop853_and_never_claims_more(case):
         assert claimed >= 0.9 * granted, f"claims {claimed:.3f} s, the reference grants {granted:.3f} s"
 
 
-def long_double_truth(scene, indices, h, frames):
-    """The reference's own equations (render/physics/reference.py, not the systems') by RK4 in numpy's long
-    double (x87's 64-bit mantissa, 11 bits past f64) at step h, sampled at the first `frames` frame times."""
-    q0, v0 = reference.initial_state(scene)
-    q, v = q0[indices].T.astype(np.longdouble), v0[indices].T.astype(np.longdouble)
-    per_frame = round(1 / (scene.video.fps * h))
-    out = [q.T.astype(np.float64)]
-    for _ in range(1, frames):
-        for _ in range(per_frame):
-            q, v = reference.rk4_step(scene, q, v, np.longdouble(1) / (scene.video.fps * per_frame))
-        out.append(q.T.astype(np.float64))
-    return np.array(out)
-
-
 def test_the_shadow_errs_a_tenth_of_the_run_at_most_where_round_off_is_the_runs_error():
     """The certificate's premise: the shadow's own error stays below a tenth of the main run's. RK4 in f64 at
     dt 1e-4 errs by round-off, not truncation; a shadow of the same plain sums at a quarter of the step made
@@ -98,7 +84,7 @@ def test_the_shadow_errs_a_tenth_of_the_run_at_most_where_round_off_is_the_runs_
     indices = certify.subsample(scene.pendulums.count, 6)
     main, sim = certify.trajectory(scene, indices, "cpu")
     shadow, _ = certify.trajectory(certify.shadow_scene(scene, sim.h), indices, "cpu", compensated=True)
-    truth = long_double_truth(scene, indices, sim.h / 4, scene.frames)
+    truth = reference.long_double(scene, indices, sim.h / 4, scene.frames)
     run_err, shadow_err = np.abs(main - truth).max(-1), np.abs(shadow - truth).max(-1)
     # where the run's error stands clear of the reference's own (at twice the step it differs by 2.3e-13: 1.5e-14
     # at this step, 16 times less); there the plain shadow's ratio was 0.82 in the median, 10.8 at most

@@ -180,6 +180,23 @@ def rk4_step(src, q: np.ndarray, v: np.ndarray, h: float) -> tuple[np.ndarray, n
     return q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
 
 
+def long_double(src, indices, h: float, frames: int) -> np.ndarray:
+    """The angles or positions (frames, len(indices), D) of those pendulums at the first `frames` frame times, by
+    rk4_step in numpy's long double (x87's 64-bit mantissa, 11 bits past f64) at step h (rounded to a whole
+    number per frame): a truth for f64 runs where DOP853 in f64 shares their round-off (an exact equilibrium,
+    late chaos). The certificate's test and benchmarks/certificate_truth.py use it."""
+    q0, v0 = initial_state(src)
+    q, v = q0[indices].T.astype(np.longdouble), v0[indices].T.astype(np.longdouble)
+    per_frame = round(1 / (src.video.fps * h))
+    step = np.longdouble(1) / (src.video.fps * per_frame)
+    out = [q.T.astype(np.float64)]
+    for _ in range(1, frames):
+        for _ in range(per_frame):
+            q, v = rk4_step(src, q, v, step)
+        out.append(q.T.astype(np.float64))
+    return np.array(out)
+
+
 def solve(src, y0, t_end: float, t_eval=None, rtol: float = RTOL, atol: float = RTOL):
     """Integrate y0 = (q0, v0), each (N, D), to t_end with DOP853.
 

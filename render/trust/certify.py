@@ -18,8 +18,10 @@ claiming pendulums faithful after they had left the truth. In the round-off regi
 rigid_chaos's 100 pendulums over-claimed, one by 4.1 s, and 4 of 8 in triple_chaos. At dt 1e-3 a quarter step
 was at times only 1.3x closer, not 256x (a pendulum's error grew 100-fold in 5 s at h/4 and 10-fold at h): 2
 over-claimed, by up to 0.6 s. Compensated sums and an eighth of the step: none of the 300, nor of the 8
-(claims on average 0.3-0.7 % short of the truth, none later; tests/test_certify.py holds the shadow under a
-tenth of the run's error against a long-double reference).
+(benchmarks/certificate_truth.py: claims on average 0.3-0.7 % short of the truth, none later). Only at an exact
+equilibrium, where f64 cannot hold the 1e-16 rad a fall starts from, was it found late, by 0.06 s
+(docs/from-the-talk.md). tests/test_certify.py holds the shadow under a tenth of the run's error against a
+long-double reference.
 
 Both runs cover every pendulum while their states at every frame fit in CERTIFY_BYTES (every shipped preset's
 fan: rainbow_1000's first pendulum breaks at 6.70 s, where its 128 evenly spaced ones, as certified before,

@@ -118,7 +118,7 @@ class Pilot:
         self.scene, self.arch, self.threads = scene, arch, threads
         self.indices = certify.subsample(scene.pendulums.count, PILOT)
         # compensated sums, as the certificate's shadow: plain, its round-off grew like the finest candidate's
-        ref = scene.replace(integrator={**setting("rk4", ref_dt, "f64"), "trig": "inline", "allow_unstable": False})
+        ref = _with(scene, {**setting("rk4", ref_dt, "f64"), "trig": "inline"})
         # As far as the target needs: a pilot's outcome is known there.
         self.frames = min(scene.frames, math.ceil(need * scene.video.fps) + 2)
         # How far a pilot looks: a pendulum still faithful there is faithful "until" here, no further (the
