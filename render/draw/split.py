@@ -230,7 +230,7 @@ class SplitScreen:
     def legend(self) -> list[str]:
         tol, unit = self.scene.integrator.tolerance, " rad" if self.angles else ""
         return [preset_name(self.scene), f"{self.scene.pendulums.count} pendulums, one start for all",
-                "cost: simulation wall time", f"{self.delta}: the largest of any pendulum",
+                "cost: force evaluations", f"{self.delta}: the largest of any pendulum",
                 "  from the finest variant's", f"parted: {self.delta} > {tol:g}{unit}",
                 "clock amber: one not faithful", "clock red: half not faithful"]
 
