@@ -51,3 +51,7 @@ def test_a_rigid_fan_fills_but_stays_in_the_frame():
     scene, sim, canvas, px = bob_pixels_over_the_run("rigid_chaos", "video.duration=10")
     assert (px[..., 0] >= 0).all() and (px[..., 0] <= W - 1).all()
     assert (px[..., 1] >= 0).all() and (px[..., 1] <= H - 1).all()
+    # fills: the chain's full length spans most of the half-height, and the bobs, flipping, reach it
+    reach_px = canvas.scale * sim.reach()
+    assert reach_px > 0.8 * H / 2, (reach_px, H)
+    assert np.hypot(px[..., 0] - canvas.cx, px[..., 1] - canvas.cy).max() > 0.95 * reach_px

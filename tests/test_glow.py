@@ -40,6 +40,13 @@ def test_coincident_pendulums_add_their_light_under_glow_only(tmp_path, effects)
     if "glow" in effects:
         assert (two[..., 0] == two[..., 1]).all() and (two[..., 1] == two[..., 2]).all()  # red + cyan: grey
         assert (four >= two).all() and (four[lit] > two[lit]).mean() > 0.9
+        # twice the light: each byte back through the tone map, light = −ln(1 − byte/255), where a byte's
+        # rounding moves it by under 2 % (two's bytes 40-180, four's below 240)
+        light = lambda b: -np.log(1.0 - b.astype(np.float64) / 255.0)  # noqa: E731
+        grey2, grey4 = two[..., 0], four[..., 0]
+        fair = (grey2 >= 40) & (grey2 <= 180) & (grey4 < 240)
+        ratio = light(grey4[fair]) / light(grey2[fair])
+        assert fair.sum() > 50 and np.abs(ratio - 2.0).max() < 0.1, (fair.sum(), ratio.min(), ratio.max())
     else:
         np.testing.assert_array_equal(four, two)
 

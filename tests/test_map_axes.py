@@ -196,11 +196,7 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     # ticks: labels with the digits a 1e-3 window needs
     labels = [t.label for t in axes.y_ticks(lay, "theta2", 2.2420, 2.2430) if t.label]
     assert "2.2420" in labels and "2.2430" in labels
-    x_labels_apart(lay, scene)
-    if shutil.which("tesseract"):  # and the frame's pixels say them: every label that reads, reads its value
-        read = labels_read_back(frames[-1], lay, scene)
-        assert all(got is None or abs(got - want) < 1e-9 for want, got in read), read
-        assert sum(got is not None for _, got in read) >= 0.75 * len(read) and len(read) >= 4, read
+    x_labels_apart(lay, scene)  # and the frame's pixels say them: test_the_tick_labels_read_back_as_their_values
     # the map against DOP853 at 48 pixels, half of them flipped
     ev = mp.event.to_numpy().astype(np.float64)
     until = mp.until.to_numpy()
@@ -225,3 +221,15 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     meta = json.loads((tmp_path / "zoom" / "metadata.json").read_text())
     assert meta["integrator"]["precision"] == "f64" and "f64" in meta["map"]["axes"]
     assert meta["map"]["axes"]["y"] == {"quantity": "theta2", "unit": "rad", "range": [2.242, 2.243]}
+
+
+@pytest.mark.skipif(shutil.which("tesseract") is None, reason="tesseract is not installed (Debian: tesseract-ocr)")
+@pytest.mark.parametrize("sets", [ZOOM, OMEGA], ids=["zoom", "omega"])
+def test_the_tick_labels_read_back_as_their_values(sets):
+    """The frame's pixels say the labels: every one that tesseract reads, reads its tick's value (the zoom's
+    2.2420 ... 2.2430, the rates' −5 ... 5), and most read."""
+    scene = load("fractal_flip", [*sets, "video.duration=0.1"])  # the axes are drawn with the first frame
+    src, frames = run_map(scene)
+    read = labels_read_back(frames[-1], src.canvas.lay, scene)
+    assert all(got is None or abs(got - want) < 1e-9 for want, got in read), read
+    assert sum(got is not None for _, got in read) >= 0.75 * len(read) and len(read) >= 4, read
