@@ -7,15 +7,17 @@ lanes; TI_PRINT_KERNEL_LLVM_IR_OPTIMIZED=1, docs/performance-log.md). No ti.init
 own command-line options live in Taichi's library, and `-force-vector-width=16` has the loop vectoriser take
 16 lanes in every loop it vectorises: a group of 16 f64 pendulums (System.CHUNK) in two 512-bit registers a
 value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance-log.md).
+A CPU with AVX-512 that LLVM 15 does not know (AMD's Zen 5) it names "generic", and there its own choice was
+slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW).
 
 No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
 what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0 and 16 lanes).
 
 LLVM's C entry point LLVMParseCommandLineOptions is in the library but not exported, so it is looked up in the
 library's ELF symbol table and called at its address. Where that cannot be done (no symbol table, another
-OS, LLVM targeting no AVX-512 CPU it knows), nothing changes. PENDULUM_VECTOR_WIDTH sets the width by hand
-(0 = LLVM's own choice), for measuring. A forced width also has LLVM print a remark for each loop it could
-not vectorise at it, which is dropped (_quiet_compiles).
+OS), or the CPU lacks AVX-512, or LLVM names it outside NARROW, nothing changes. PENDULUM_VECTOR_WIDTH sets the
+width by hand (0 = LLVM's own choice), for measuring. A forced width also has LLVM print a remark for each loop
+it could not vectorise at it, which is dropped (_quiet_compiles).
 
 Taichi's offline cache keys a kernel by its source and Taichi's settings, not LLVM's options, so kernels
 compiled at a forced width are cached in a subfolder of their own: a cache filled at the other width is never
@@ -40,6 +42,11 @@ from ..errors import SceneError
 # not among them: LLVM 15 predates it and names it znver3, an AVX2 CPU, so Taichi compiles for AVX2 there.
 PREFER_256 = frozenset({"skylake-avx512", "cascadelake", "cooperlake", "cannonlake", "icelake-client",
                         "icelake-server", "rocketlake", "tigerlake", "sapphirerapids"})
+# "generic": LLVM 15's name for a CPU it does not know, such as AMD's Zen 5 (family 26, EPYC 9005), tuned as a
+# baseline x86-64; with AVX-512 in /proc/cpuinfo, 16 lanes there took rigid RK4 at N = 1e5 from 38 to 207 M
+# steps/s in f64 and 90 to 261 M in f32, the same states (`python benchmarks/vector_width.py --widths 0 8 16
+# --rounds 2`, 2-core AMD EPYC, 2026-12-07; 8 lanes: 154 and 179 M).
+NARROW = PREFER_256 | {"generic"}  # where WIDTH is set unless PENDULUM_VECTOR_WIDTH says otherwise
 # Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64;
 # 32 is more in f32 but leaves a 16-lane f64 loop to its scalar remainder (23M against 128M steps/s), and the
 # option is one for every loop of the process.
@@ -72,25 +79,42 @@ def planned() -> int:
 
 def _plan():
     """(width, LLVMParseCommandLineOptions as a callable): the width PENDULUM_VECTOR_WIDTH asks for, else WIDTH
-    where LLVM targets a CPU of PREFER_256; (0, None) where it is LLVM's own or cannot be set."""
+    where the CPU has AVX-512 and LLVM targets it as one of NARROW; (0, None) where it is LLVM's own or cannot be
+    set."""
     asked = os.environ.get(ENV, "").strip()
     if asked and asked not in WIDTHS:
         raise SceneError(f"${ENV}: {asked!r} is not a width: one of {', '.join(WIDTHS)} (0: LLVM's own)")
     if asked == "0" or not (asked or "avx512f" in simd_flags()):  # no AVX-512: nothing to look up
         return 0, None
+    llvm = _llvm()
+    if llvm is None or not (asked or _host_cpu(llvm) in NARROW):
+        return 0, None
+    parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
+    return int(asked or WIDTH), parse(llvm["LLVMParseCommandLineOptions"])
+
+
+def llvm_cpu() -> str | None:
+    """The CPU LLVM compiles Taichi's kernels for, by LLVM's name ("generic" where it does not know it), or None
+    where it cannot be asked: for the bench's report."""
+    llvm = _llvm()
+    return None if llvm is None else _host_cpu(llvm)
+
+
+def _llvm() -> dict[str, int] | None:
+    """The addresses, in this process, of the LLVM functions called here, or None where they cannot be found."""
     lib = _library()
     names = ("LLVMParseCommandLineOptions", "_ZN4llvm3sys14getHostCPUNameEv", "PyInit_taichi_python")
     syms = _symbols(lib, names) if lib else {}
     if len(syms) < len(names):
-        return 0, None
+        return None
     so = ctypes.CDLL(lib)  # already loaded by taichi: the same handle, so the same load address
     base = ctypes.cast(so.PyInit_taichi_python, ctypes.c_void_p).value - syms["PyInit_taichi_python"]
-    if not asked:
-        cpu = ctypes.CFUNCTYPE(_StringRef)(base + syms["_ZN4llvm3sys14getHostCPUNameEv"])()
-        if ctypes.string_at(cpu.data, cpu.size).decode() not in PREFER_256:
-            return 0, None
-    parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
-    return int(asked or WIDTH), parse(base + syms["LLVMParseCommandLineOptions"])
+    return {name: base + at for name, at in syms.items()}
+
+
+def _host_cpu(llvm: dict[str, int]) -> str:
+    cpu = ctypes.CFUNCTYPE(_StringRef)(llvm["_ZN4llvm3sys14getHostCPUNameEv"])()
+    return ctypes.string_at(cpu.data, cpu.size).decode()
 
 
 def simd_flags() -> list[str]:

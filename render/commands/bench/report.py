@@ -44,6 +44,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind,
                        "simd": vector_width.simd_flags(),
                        "vector_width": vector_width.planned(),  # the phases' processes set it so
+                       "llvm_cpu": vector_width.llvm_cpu(),  # what Taichi's LLVM takes the CPU for
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
            "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
@@ -108,8 +109,9 @@ def with_spread(s: dict | None, spec=".2f") -> str:
 
 
 def width_text(machine: dict) -> str:
-    w = machine.get("vector_width")
-    return f"kernels vectorised at {w} lanes" if w else "kernels vectorised at LLVM's own width"
+    w, cpu = machine.get("vector_width"), machine.get("llvm_cpu")
+    lanes = f"vectorised at {w} lanes" if w else "vectorised at LLVM's own width"
+    return f"LLVM's CPU {cpu}, kernels {lanes}" if cpu else f"kernels {lanes}"
 
 
 def load_text(load) -> str:
