@@ -43,9 +43,10 @@ from ..errors import SceneError
 PREFER_256 = frozenset({"skylake-avx512", "cascadelake", "cooperlake", "cannonlake", "icelake-client",
                         "icelake-server", "rocketlake", "tigerlake", "sapphirerapids"})
 # "generic": LLVM 15's name for a CPU it does not know, such as AMD's Zen 5 (family 26, EPYC 9005), tuned as a
-# baseline x86-64; with AVX-512 in /proc/cpuinfo, 16 lanes there took rigid RK4 at N = 1e5 from 38 to 207 M
-# steps/s in f64 and 90 to 261 M in f32, the same states (`python benchmarks/vector_width.py --widths 0 8 16
-# --rounds 2`, 2-core AMD EPYC, 2026-12-07; 8 lanes: 154 and 179 M).
+# baseline x86-64: the rigid f64 advance's optimised IR held 782 `<2 x double>` operations, SSE2's width, and
+# 833 `<16 x double>` at 16 lanes. With AVX-512 in /proc/cpuinfo, 16 lanes there took rigid RK4 at N = 1e5 from
+# 38 to 207 M steps/s in f64 and 90 to 261 M in f32, the same states (`python benchmarks/vector_width.py
+# --widths 0 8 16 --rounds 2`, 2-core AMD EPYC, 2026-12-07; 8 lanes: 154 and 179 M).
 NARROW = PREFER_256 | {"generic"}  # where WIDTH is set unless PENDULUM_VECTOR_WIDTH says otherwise
 # Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64;
 # 32 is more in f32 but leaves a 16-lane f64 loop to its scalar remainder (23M against 128M steps/s), and the
