@@ -185,7 +185,7 @@ def test_a_1e_3_rad_zoom_runs_in_f64_and_its_trusted_pixels_agree_with_dop853(tm
     assert scene.integrator.precision == "f64"
     why = grid.axes_summary(scene)["f64"]
     assert "theta1" in why and "f32" in why
-    src, frames = run_map(scene)
+    src, _ = run_map(scene)
     lay, mp = src.canvas.lay, src.canvas
     # the starts: every pixel its own, one step apart (f32 would round 1.7e-5 rad steps to multiples of 2.4e-7)
     q0, _ = src.sim.initial_state()
