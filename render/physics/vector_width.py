@@ -26,6 +26,7 @@ taken for this one.
 from __future__ import annotations
 
 import ctypes
+import functools
 import mmap
 import os
 import re
@@ -101,6 +102,7 @@ def llvm_cpu() -> str | None:
     return None if llvm is None else _host_cpu(llvm)
 
 
+@functools.cache  # the library's symbol table is read once a process (the bench asks for the CPU twice)
 def _llvm() -> dict[str, int] | None:
     """The addresses, in this process, of the LLVM functions called here, or None where they cannot be found."""
     lib = _library()
