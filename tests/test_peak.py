@@ -14,7 +14,8 @@ def test_peak_kernel_computes_every_chain_exactly(prec):
     iters = 3
     p.run(iters)
     got = p.out.to_numpy()
-    assert got.shape == (peak.GROUPS, peak.CHAINS, peak.LANES[prec])
+    assert got.shape == (peak.GROUPS, p.count, p.lanes)
+    assert p.count * p.lanes == peak.CHAINS * peak.LANES[prec]  # as many accumulators at any forced width
     dt = np.float64 if prec == "f64" else np.float32
     a0 = (np.arange(got.size).reshape(got.shape).astype(dt) + dt(1)) * dt(1.0 / (got.size + 1))
     a = a0.copy()

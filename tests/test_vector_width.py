@@ -1,4 +1,4 @@
-"""render/physics/vector_width.py: LLVM's loop vectoriser at 16 lanes changes the code, never the numbers.
+"""render/physics/vector_width.py: LLVM's loop vectoriser at 16 or 32 lanes changes the code, never the numbers.
 
 The width is set by hand here (PENDULUM_VECTOR_WIDTH), so both widths are checked on either CPU kind: on an
 AVX2 machine a 16-lane vector is 4 registers, on AVX-512 2.
@@ -35,12 +35,14 @@ if ir_only:  # the optimised IR of every kernel compiled, from an empty cache
     out["kernels"], out["advance"] = len(ir), len(advance)
     out["wide"] = sum(t.count(" <16 x double>") for t in ir)
     out["wide_in_advance"] = sum(t.count("fmul <16 x double>") for t in advance)
-else:  # a frame as render draws it: trails, bobs, HUD
-    from render.video import pipeline
+else:  # a frame as render draws it (trails, bobs, HUD), as the MP4 takes it (YUV) and shrunk as the GIF's
+    from render.video import downscale, pipeline, yuv
     src = pipeline.Source(load("rigid_chaos", ["video.width=320", "video.height=180", "video.duration=1"]))
     for _ in range(12):
         frame = src.next_frame()
     out["frame"] = hashlib.sha1(frame.tobytes()).hexdigest()
+    out["yuv"] = hashlib.sha1(yuv.convert(frame).tobytes()).hexdigest()
+    out["shrunk"] = hashlib.sha1(downscale.shrink(frame, 136, 76).tobytes()).hexdigest()
 out["width"] = vector_width.apply()
 print(json.dumps(out))
 """
@@ -70,8 +72,15 @@ def test_sixteen_lanes_compile_wider_and_integrate_and_draw_the_same_bits(tmp_pa
     assert wide["wide_in_advance"] > 100  # the RK4 step's products, each on 16 pendulums at once
     same = {k: v for k, v in narrow.items() if k not in ("width", "wide", "wide_in_advance", "drawn width")}
     assert sorted(same) == ["advance", "drawn frame", "drawn rigid_chaos f32", "drawn rigid_chaos f64",
-                            "drawn triple_chaos f32", "drawn triple_chaos f64", "kernels", "rigid_chaos f64"]
+                            "drawn shrunk", "drawn triple_chaos f32", "drawn triple_chaos f64", "drawn yuv", "kernels",
+                            "rigid_chaos f64"]
     assert same == {k: wide[k] for k in same}, "the width changed the numbers"
+    # 32 lanes (the width on a CPU LLVM calls generic): groups of 32 pendulums, the canvas's trails faded 32
+    # pixels at a time, the YUV conversion and the GIF's shrink 32 words at a time (vector_width.lanes)
+    wider = child("draw", 32, tmp_path)
+    assert wider["width"] == 32
+    assert {k[len("drawn "):]: v for k, v in same.items() if k.startswith("drawn ")} == \
+        {k: v for k, v in wider.items() if k != "width"}, "32 lanes changed the numbers"
 
 
 def test_the_elf_symbol_table_gives_the_address_the_dynamic_linker_gives():

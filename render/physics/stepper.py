@@ -44,10 +44,12 @@ class Run:
                  precision: str | None = None, keep_log: bool = False, compensated: bool = False):
         # Taichi is imported with the first Run, not with this module: the certificate's and the quality
         # levels' modules import Run, and the run-time estimate reads their sizes without running anything.
-        from . import runtime
+        from . import runtime, vector_width
 
         self.scene = scene
-        self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log)  # the one in use
+        # the FTLE map's tangents take fewer lanes well (vector_width.TANGENTS)
+        lanes = vector_width.TANGENTS if scene.fractal == "lyapunov" else None
+        self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log, lanes)  # in use
         self.generation = runtime.generation()
         self.sim = build(scene, subset, precision, compensated)
 

@@ -14,7 +14,7 @@ contract (LINKS, bob_sizes(), reach(), lengths). Only stepper.Run builds one wit
 import numpy as np
 import taichi as ti
 
-from . import crossings, dual, launch, runtime, steps
+from . import crossings, dual, launch, runtime, steps, vector_width
 from .plan import Plan
 from .recording import Recording
 from .sincos import sincos
@@ -43,7 +43,8 @@ class System(Plan, Recording, runtime.Launcher):
             return
         self.tol = 1e-14 if scene.integrator.precision == "f64" else 1e-6  # implicit solves, in state units
         real = runtime.real()
-        self.chunk = self.CHUNK * (2 if real == ti.f32 else 1)  # 4 vector registers of lanes either way
+        # 4 AVX2 registers of lanes either way, or as many as a forced width takes (vector_width.lanes)
+        self.chunk = vector_width.lanes(self.CHUNK * (2 if real == ti.f32 else 1))
         self.groups = -(-self.n // self.chunk)
         self.q = runtime.field("state.q", real, self.n, self.D)
         self.v = runtime.field("state.v", real, self.n, self.D)
@@ -181,8 +182,8 @@ class System(Plan, Recording, runtime.Launcher):
         The group is copied into local D × chunk matrices Q, V, indexed by a runtime column (so they stay one
         stack array rather than chunk·D scalars), and each substep is a loop over those columns that steps one
         pendulum (a D × 1 lane matrix) at a time. With no call and no branch on values in the step, LLVM's
-        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction (16 in two AVX-512 registers where
-        render/physics/vector_width.py sets the width): that loop is the SIMD. Every
+        loop vectoriser runs 4 (f64) or 8 (f32) columns per AVX2 instruction (16 or 32 a time in AVX-512 registers
+        where render/physics/vector_width.py sets the width): that loop is the SIMD. Every
         pendulum goes through the same instructions whatever its group or thread, so frames are byte-identical
         at any thread count. The last group repeats its last pendulum as padding; only real ones are written."""
         B = ti.static(self.chunk)

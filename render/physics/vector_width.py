@@ -8,7 +8,8 @@ own command-line options live in Taichi's library, and `-force-vector-width=16` 
 16 lanes in every loop it vectorises: a group of 16 f64 pendulums (System.CHUNK) in two 512-bit registers a
 value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance-log.md).
 A CPU with AVX-512 that LLVM 15 does not know (AMD's Zen 5) it names "generic", and there its own choice was
-slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW).
+slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW), and 32 faster again (WIDER). The loops
+sized for the vectoriser take lanes() columns, at least the width, so that a wider one is never left scalar.
 
 No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
 what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0 and 16 lanes).
@@ -48,23 +49,34 @@ PREFER_256 = frozenset({"skylake-avx512", "cascadelake", "cooperlake", "cannonla
 # 833 `<16 x double>` at 16 lanes. With AVX-512 in /proc/cpuinfo, 16 lanes there took rigid RK4 at N = 1e5 from
 # 38 to 207 M steps/s in f64 and 90 to 261 M in f32, the same states (`python benchmarks/vector_width.py
 # --widths 0 8 16 --rounds 2`, 2-core AMD EPYC, 2026-12-07; 8 lanes: 154 and 179 M).
-NARROW = PREFER_256 | {"generic"}  # where WIDTH is set unless PENDULUM_VECTOR_WIDTH says otherwise
+NARROW = PREFER_256 | {"generic"}  # where a width is set unless PENDULUM_VECTOR_WIDTH says otherwise
 # Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64;
 # 32 is more in f32 but leaves a 16-lane f64 loop to its scalar remainder (23M against 128M steps/s), and the
 # option is one for every loop of the process.
 WIDTH = 16
+# Where LLVM names the CPU "generic" (Zen 5), 32 lanes, and every loop sized for the vectoriser takes at least
+# that many columns (lanes()), so none is left to its scalar remainder: rigid RK4 at N = 1e5 205 → 233 M steps/s
+# in f64 (groups of 32), 262 → 331 M in f32; a 720p frame's simulation, divergence map 46.7 → 39.8 ms, FTLE map
+# 212 → 168 ms; the same states (benchmarks/vector_width.py, benchmarks/map_frame.py, 2-core AMD EPYC,
+# 2026-12-07; docs/performance.md). Not measured on the Intel CPUs of PREFER_256, which keep 16.
+WIDER = {"generic": 32}
+# But a kernel that carries tangent vectors (the FTLE map's 20 values a lane) spills its registers at 32 lanes: a
+# 720p frame's simulation took 144-151 ms against 121-123 at 16 (python benchmarks/map_frame.py fractal_lyapunov,
+# interleaved, 2-core AMD EPYC), so a process that starts with such a scene takes at most 16 (apply(most)).
+TANGENTS = 16
 ENV, WIDTHS = "PENDULUM_VECTOR_WIDTH", ("0", "1", "2", "4", "8", "16", "32", "64")  # LLVM takes powers of 2
 _SYM = np.dtype([("name", "<u4"), ("info", "u1"), ("other", "u1"), ("shndx", "<u2"), ("value", "<u8"),
                  ("size", "<u8")])
 _done: int | None = None  # the width this process set (0: none); LLVM's options are parsed once per process
 
 
-def apply() -> int:
+def apply(most: int | None = None) -> int:
     """Set the loop vectoriser's width for this process, once, before any kernel compiles; returns the width
-    set, 0 where LLVM keeps its own. Also points Taichi's offline cache at the width's own subfolder."""
+    set, 0 where LLVM keeps its own. most: the most lanes the process's work takes well (TANGENTS), where the
+    width is the CPU's and not asked for. Also points Taichi's offline cache at the width's own subfolder."""
     global _done
     if _done is None:
-        width, parse = _plan()
+        width, parse = _plan(most)
         if width:
             argv = [b"pendulum", f"-force-vector-width={width}".encode()]
             parse(len(argv), (ctypes.c_char_p * len(argv))(*argv), b"")
@@ -74,25 +86,35 @@ def apply() -> int:
     return _done
 
 
-def planned() -> int:
-    """The width apply() sets, or set, in this process (0: LLVM's own), without setting it."""
-    return _done if _done is not None else _plan()[0]
+def planned(most: int | None = None) -> int:
+    """The width apply(most) sets, or set, in this process (0: LLVM's own), without setting it."""
+    return _done if _done is not None else _plan(most)[0]
 
 
-def _plan():
+def _plan(most: int | None = None):
     """(width, LLVMParseCommandLineOptions as a callable): the width PENDULUM_VECTOR_WIDTH asks for, else WIDTH
-    where the CPU has AVX-512 and LLVM targets it as one of NARROW; (0, None) where it is LLVM's own or cannot be
-    set."""
+    (or WIDER's for the CPU) where the CPU has AVX-512 and LLVM targets it as one of NARROW; (0, None) where it
+    is LLVM's own or cannot be set."""
     asked = os.environ.get(ENV, "").strip()
     if asked and asked not in WIDTHS:
         raise SceneError(f"${ENV}: {asked!r} is not a width: one of {', '.join(WIDTHS)} (0: LLVM's own)")
     if asked == "0" or not (asked or "avx512f" in simd_flags()):  # no AVX-512: nothing to look up
         return 0, None
     llvm = _llvm()
-    if llvm is None or not (asked or _host_cpu(llvm) in NARROW):
+    cpu = None if llvm is None else _host_cpu(llvm)
+    if llvm is None or not (asked or cpu in NARROW):
         return 0, None
     parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
-    return int(asked or WIDTH), parse(llvm["LLVMParseCommandLineOptions"])
+    width = int(asked) if asked else WIDER.get(cpu, WIDTH)
+    width = width if asked or not most else min(width, most)
+    return width, parse(llvm["LLVMParseCommandLineOptions"])
+
+
+def lanes(least: int) -> int:
+    """Columns for a loop sized for the vectoriser (a group of pendulums, a run of pixels): `least`, or the
+    width this process set where that is more, since a loop of fewer iterations than the width is left to its
+    scalar remainder. Call after runtime.init (apply()); the columns never change a result's bits."""
+    return max(least, _done or 0)
 
 
 def llvm_cpu() -> str | None:

@@ -20,10 +20,11 @@ import functools
 import numpy as np
 import taichi as ti
 
-from ..physics import runtime
+from ..physics import runtime, vector_width
 from .yuv import serial
 
-LANES = 16  # words of a row summed at a time: one AVX-512 register of 32-bit lanes (two AVX2 ones)
+LANES = 16  # words of a row summed at a time: one AVX-512 register of 32-bit lanes (two AVX2 ones), or a forced
+# width's (render/physics/vector_width.py's lanes())
 
 
 @functools.lru_cache(maxsize=16)
@@ -46,19 +47,20 @@ def _rows(frame: ti.types.ndarray(dtype=ti.u32, ndim=1), rows: ti.types.ndarray(
     """Each output row's sums of the frame's n rows it covers, by their shares, a byte at a time: `span` words
     a row. LANES words are read into an array on the stack and summed there, in the loop that touches no
     array argument (the one LLVM vectorises, as in render/video/yuv.py)."""
-    runs = (span + LANES - 1) // LANES
+    L = ti.static(vector_width.lanes(LANES))
+    runs = (span + L - 1) // L
     ti.loop_config(serialize=serial)
     for t in range(first.shape[0] * runs):
-        r, x0 = t // runs, (t % runs) * LANES
-        last = ti.min(LANES, span - x0) - 1
-        acc = ti.Matrix.zero(ti.i32, 4, LANES)
+        r, x0 = t // runs, (t % runs) * L
+        last = ti.min(L, span - x0) - 1
+        acc = ti.Matrix.zero(ti.i32, 4, L)
         for k in range(share.shape[1]):
             s = share[r, k]
             base = ti.min(first[r] + k, n - 1) * span + x0
-            v = ti.Vector.zero(ti.u32, LANES)
-            for p in range(LANES):
+            v = ti.Vector.zero(ti.u32, L)
+            for p in range(L):
                 v[p] = frame[base + ti.min(p, last)]
-            for p in range(LANES):  # the loop LLVM vectorises
+            for p in range(L):  # the loop LLVM vectorises
                 for b in ti.static(range(4)):  # x86 is little-endian: byte 0 of a word is its lowest
                     acc[b, p] += s * ti.cast((v[p] >> (8 * b)) & 0xFF, ti.i32)
         for p in range(last + 1):

@@ -17,7 +17,7 @@ rigid_chaos: `python benchmarks/mp4_psnr.py`).
 import numpy as np
 import taichi as ti
 
-from ..physics import launch, runtime
+from ..physics import launch, runtime, vector_width
 
 SHIFT = 16  # coefficients are BT.601's times 2**SHIFT, rounded
 Y = (16829, 33039, 6416)  # 0.256788, 0.504129, 0.097906: 219/255 of the luma weights 0.299, 0.587, 0.114
@@ -47,7 +47,8 @@ def _round(v, shift: ti.template()):
     return (v + (1 << (shift - 1))) >> shift  # >> floors: adding half first rounds to nearest
 
 
-# Groups converted at a time: 16 words of 32 bits, one AVX-512 register (two AVX2 ones). Taichi's CPU threads
+# Groups converted at a time: 16 words of 32 bits, one AVX-512 register (two AVX2 ones), or as many as a forced
+# width takes (render/physics/vector_width.py's lanes()). Taichi's CPU threads
 # take a parallel loop in blocks of at least 512 iterations (render/physics/runtime.py), so the loop is over
 # runs of groups, not rows: 720p is 360 rows of 20 runs.
 LANES = 16
@@ -77,15 +78,16 @@ def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(d
     of black groups is only read and written, and where `lit` says that all its tiles (2^shift pixels a side;
     shift 0: no tiles known) are black, only written. The arrays are flat: 2-D ndarray indexing made the same
     loop 5 times slower."""
+    L = ti.static(vector_width.lanes(LANES))
     gw = w // 4
     rows = cb2.shape[0] // gw  # rows of groups: half the frame's height
-    runs = (gw + LANES - 1) // LANES
+    runs = (gw + L - 1) // L
     ti.loop_config(serialize=serial)
     for t in range(rows * runs):
-        gy, g0 = t // runs, (t % runs) * LANES
-        n = ti.min(LANES, gw - g0)
+        gy, g0 = t // runs, (t % runs) * L
+        n = ti.min(L, gw - g0)
         top = 2 * gy * 3 * gw + 3 * g0  # the first group's first word in the top row; the bottom row 3 * gw on
-        words = ti.Matrix.zero(ti.u32, 6, LANES)
+        words = ti.Matrix.zero(ti.u32, 6, L)
         bright = ti.u32(0)
         dark = False
         if ti.static(shift):  # both rows of a group lie in one row of tiles, since tiles are an even size
@@ -98,15 +100,15 @@ def _convert(rgb: ti.types.ndarray(dtype=ti.u32, ndim=1), y4: ti.types.ndarray(d
                 for r, k in ti.static(ti.ndrange(2, 3)):
                     words[3 * r + k, p] = rgb[top + 3 * gw * r + 3 * p + k]
                     bright |= words[3 * r + k, p]
-        luma = ti.Matrix.zero(ti.u32, 2, LANES)
-        cb = ti.Vector.zero(ti.u32, LANES)
-        cr = ti.Vector.zero(ti.u32, LANES)
+        luma = ti.Matrix.zero(ti.u32, 2, L)
+        cb = ti.Vector.zero(ti.u32, L)
+        cr = ti.Vector.zero(ti.u32, L)
         if bright == 0:
-            for p in range(LANES):
+            for p in range(L):
                 luma[0, p], luma[1, p], cb[p], cr[p] = ti.u32(BLACK_Y), ti.u32(BLACK_Y), ti.u32(BLACK_C), \
                     ti.u32(BLACK_C)
         else:
-            for p in range(LANES):  # the loop LLVM vectorises
+            for p in range(L):  # the loop LLVM vectorises
                 sums = ti.Matrix.zero(ti.i32, 2, 3)  # channel sums of the group's left and right 2×2 blocks
                 for r in ti.static(range(2)):
                     for q in ti.static(range(4)):

@@ -7,11 +7,12 @@ CHAINS accumulators for each of its LANES pendulum-like columns in a local matri
 is the one LLVM's loop vectoriser runs (as in System.advance), and each column takes UNROLL steps of every
 chain per visit, so CHAINS · UNROLL products and sums per load and store of the matrix. CHAINS independent
 vectors are enough to keep the multiply and add pipes busy through their latency (12 x 8 was the fastest
-of the shapes tried on an AVX2 machine here: 8 to 24 chains, 4 to 16 steps). The accumulators are written
+of the shapes tried on an AVX2 machine here: 8 to 24 chains, 4 to 16 steps; where a forced width takes more
+lanes, fewer chains in as many registers). The accumulators are written
 to a field, so nothing can be optimised away, and a run's result is a fixed function of its arguments
 (tests/test_peak.py: bit for bit the same recurrence in numpy). Checked in the generated assembly: the
-steps are vmulpd and vaddpd on ymm registers, no FMA (zmm where render/physics/vector_width.py sets 16 lanes,
-as it does for the RK4 kernel timed against this one).
+steps are vmulpd and vaddpd on ymm registers, no FMA (zmm where render/physics/vector_width.py sets 16 or 32
+lanes, as it does for the RK4 kernel timed against this one).
 
 runtime.init runs Taichi with fast_math off, under which LLVM may not fuse a·b + c into an FMA: each step is
 a multiply and an add (2 flops, as an FMA counts them), the same instructions the rigid kernel is made of.
@@ -22,10 +23,10 @@ rate as FMAs; on a CPU that runs both on its FMA ports it is half the FMA peak.
 import taichi as ti
 
 from . import peers
-from ...physics import runtime
+from ...physics import runtime, vector_width
 
 CHAINS, UNROLL = 12, 8
-LANES = {"f64": 16, "f32": 32}  # 4 AVX2 registers of lanes either way (System.CHUNK)
+LANES = {"f64": 16, "f32": 32}  # 4 AVX2 registers of lanes either way, or a forced width's (as System.chunk)
 GROUPS = 1024  # parallel items: many per core even on a large machine, so a busy core delays only its share
 # (spread by runtime.SPREAD: in Taichi's blocks of 512 iterations they were two tasks, two threads at most)
 B, C = 0.999, 0.001  # a -> c / (1 - b) = 1 from any start: no overflow, no subnormal, at any iteration count
@@ -56,11 +57,15 @@ def rigid_rk4_flops(precision: str, lengths, masses) -> int:
 class Peak:
     def __init__(self, groups: int = GROUPS):
         self.precision = "f64" if runtime.real() == ti.f64 else "f32"
-        self.lanes, self.groups = LANES[self.precision], groups
-        self.out = runtime.field("peak.accumulators", runtime.real(), (groups, CHAINS, self.lanes))
+        self.lanes, self.groups = vector_width.lanes(LANES[self.precision]), groups
+        # as many registers of accumulators at a forced width as at 16 f64 lanes: 12 chains of 32 f64 lanes were
+        # 48 zmm registers, of which 16 spilled to memory (86 GFLOPS against 265 at 16 lanes; 6 chains: 2-core
+        # AMD EPYC, python benchmarks/vector_width.py --widths 16 32)
+        self.count = max(1, CHAINS * LANES[self.precision] // self.lanes)
+        self.out = runtime.field("peak.accumulators", runtime.real(), (groups, self.count, self.lanes))
 
     def flops(self, iters: int) -> float:
-        return 2.0 * self.groups * CHAINS * self.lanes * UNROLL * iters
+        return 2.0 * self.groups * self.count * self.lanes * UNROLL * iters
 
     @ti.kernel
     def chains(self, iters: ti.i32, b: float, c: float):
@@ -70,9 +75,9 @@ class Peak:
         for t in range(self.groups * S):  # spread over the threads as the advance kernel is (runtime.SPREAD)
             if t % S == 0:
                 g = t // S
-                A = ti.Matrix.zero(float, CHAINS, L)
+                A = ti.Matrix.zero(float, self.count, L)
                 for lane in range(L):
-                    for k in ti.static(range(CHAINS)):
+                    for k in ti.static(range(self.count)):
                         A[k, lane] = self.start(g, k, lane)
                 for _ in range(iters):
                     for lane in range(L):  # the loop LLVM vectorises
@@ -81,14 +86,14 @@ class Peak:
                             a = a * b + c
                         A[:, lane] = a
                 for lane in range(L):
-                    for k in ti.static(range(CHAINS)):
+                    for k in ti.static(range(self.count)):
                         self.out[g, k, lane] = A[k, lane]
 
     @ti.func
     def start(self, g, k, lane):
         """(flat index + 1) / (count + 1), in (0, 1): every chain starts elsewhere (exact in f32 too: < 2^24)."""
-        i = (g * CHAINS + k) * self.lanes + lane
-        return (ti.cast(i, float) + 1.0) * (1.0 / (self.groups * CHAINS * self.lanes + 1))
+        i = (g * self.count + k) * self.lanes + lane
+        return (ti.cast(i, float) + 1.0) * (1.0 / (self.groups * self.count * self.lanes + 1))
 
     def run(self, iters: int, b: float = B, c: float = C):
         self.chains(iters, b, c)

@@ -44,6 +44,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind,
                        "simd": vector_width.simd_flags(),
                        "vector_width": vector_width.planned(),  # the phases' processes set it so
+                       "vector_width_ftle": vector_width.planned(vector_width.TANGENTS),  # and the FTLE map's
                        "llvm_cpu": vector_width.llvm_cpu(),  # what Taichi's LLVM takes the CPU for
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
@@ -109,8 +110,9 @@ def with_spread(s: dict | None, spec=".2f") -> str:
 
 
 def width_text(machine: dict) -> str:
-    w, cpu = machine.get("vector_width"), machine.get("llvm_cpu")
+    w, cpu, ftle = machine.get("vector_width"), machine.get("llvm_cpu"), machine.get("vector_width_ftle")
     lanes = f"vectorised at {w} lanes" if w else "vectorised at LLVM's own width"
+    lanes += f" ({ftle} for the FTLE map)" if ftle and ftle != w else ""
     return f"LLVM's CPU {cpu}, kernels {lanes}" if cpu else f"kernels {lanes}"
 
 
