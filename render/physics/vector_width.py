@@ -12,7 +12,7 @@ slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW), and 32 f
 sized for the vectoriser take lanes() columns, at least the width, so that a wider one is never left scalar.
 
 No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
-what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0 and 16 lanes).
+what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0, 16 and 32 lanes).
 
 LLVM's C entry point LLVMParseCommandLineOptions is in the library but not exported, so it is looked up in the
 library's ELF symbol table and called at its address. Where that cannot be done (no symbol table, another

@@ -58,9 +58,9 @@ class Peak:
     def __init__(self, groups: int = GROUPS):
         self.precision = "f64" if runtime.real() == ti.f64 else "f32"
         self.lanes, self.groups = vector_width.lanes(LANES[self.precision]), groups
-        # as many registers of accumulators at a forced width as at 16 f64 lanes: 12 chains of 32 f64 lanes were
-        # 48 zmm registers, of which 16 spilled to memory (86 GFLOPS against 265 at 16 lanes; 6 chains: 2-core
-        # AMD EPYC, python benchmarks/vector_width.py --widths 16 32)
+        # as many registers of accumulators at a forced width as at 16 f64 lanes: 12 chains of 32 f64 lanes are
+        # 48 zmm registers, more than there are, and ran at 86 GFLOPS against 265 at 16 lanes; 6 chains at 267
+        # (2-core AMD EPYC, python benchmarks/vector_width.py --widths 16 32)
         self.count = max(1, CHAINS * LANES[self.precision] // self.lanes)
         self.out = runtime.field("peak.accumulators", runtime.real(), (groups, self.count, self.lanes))
 
