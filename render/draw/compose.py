@@ -157,8 +157,9 @@ class Compose:
         kernel cache (`TI_OFFLINE_CACHE_FILE_PATH=$(mktemp -d) pendulum render rigid_chaos`) took 23.0 s, two
         rows at a time 20.3 s (15.7-16.4 s on 2026-12-07, before this order and after it alike). A pixel off the
         trail (0) fades to 0: no branch, and dark pixels stay dark."""
-        # pixels at a time: two rows, or four where LLVM takes 32 lanes a loop (so their 96 channels are 3 passes,
-        # where 48 would leave 16 to the scalar remainder: rigid_chaos's draw_frame 1.44-1.48 → 1.59-1.61 ms)
+        # pixels at a time: two rows, or four where LLVM takes 32 lanes a loop, so that their 96 channels are 3
+        # passes; 48 left 16 to the scalar remainder (rigid_chaos's draw_frame at 32 lanes: 1.59-1.61 ms with 48,
+        # 1.34-1.38 with 96, 1.38-1.44 at 16 lanes; benchmarks/draw_kernels.py, 2-core AMD EPYC)
         P = ti.static(min(vector_width.lanes(2 * self.TILE), self.TILE * self.TILE))
         N = ti.static(3 * P)  # their channels, in the fields' order (pixel-major): 48 lanes at 16
         any_lit = 0

@@ -55,10 +55,11 @@ NARROW = PREFER_256 | {"generic"}  # where a width is set unless PENDULUM_VECTOR
 # option is one for every loop of the process.
 WIDTH = 16
 # Where LLVM names the CPU "generic" (Zen 5), 32 lanes, and every loop sized for the vectoriser takes at least
-# that many columns (lanes()), so none is left to its scalar remainder: rigid RK4 at N = 1e5 205 → 233 M steps/s
-# in f64 (groups of 32), 262 → 331 M in f32; a 720p frame's simulation, divergence map 46.7 → 39.8 ms, FTLE map
-# 212 → 168 ms; the same states (benchmarks/vector_width.py, benchmarks/map_frame.py, 2-core AMD EPYC,
-# 2026-12-07; docs/performance.md). Not measured on the Intel CPUs of PREFER_256, which keep 16.
+# that many columns (lanes()), so none is left to its scalar remainder. From 16 to 32 lanes, alternating: rigid
+# RK4 at N = 1e5 207 → 236 M steps/s in f64 (groups of 32), 263 → 337 M in f32; a 720p frame's simulation, flip
+# map 14.7-18.0 → 13.5-14.2 ms, divergence map 43.9-52.7 → 39.0-39.4 ms; rigid_chaos's frame simulated and drawn
+# 1.63-1.66 → 1.54 ms; the same states and frames (2-core AMD EPYC, 2026-12-07: docs/performance.md names the
+# commands). Not measured on the Intel CPUs of PREFER_256, which keep 16.
 WIDER = {"generic": 32}
 # But a kernel that carries tangent vectors (the FTLE map's 20 values a lane) spills its registers at 32 lanes: a
 # 720p frame's simulation took 144-151 ms against 121-123 at 16 (python benchmarks/map_frame.py fractal_lyapunov,
