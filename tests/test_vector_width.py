@@ -43,6 +43,11 @@ else:  # a frame as render draws it (trails, bobs, HUD), as the MP4 takes it (YU
     out["frame"] = hashlib.sha1(frame.tobytes()).hexdigest()
     out["yuv"] = hashlib.sha1(yuv.convert(frame).tobytes()).hexdigest()
     out["shrunk"] = hashlib.sha1(downscale.shrink(frame, 136, 76).tobytes()).hexdigest()
+    # an FTLE map's frame: its tangent vectors in the system's groups (render/maps/ftle.py)
+    ftle = pipeline.Source(load("fractal_lyapunov", ["video.width=96", "video.height=54", "video.duration=0.2"]))
+    for _ in range(3):
+        frame = ftle.next_frame()
+    out["ftle"] = hashlib.sha1(frame.tobytes()).hexdigest()
 out["width"] = vector_width.apply()
 print(json.dumps(out))
 """
@@ -71,16 +76,18 @@ def test_sixteen_lanes_compile_wider_and_integrate_and_draw_the_same_bits(tmp_pa
     assert narrow["wide"] == 0  # LLVM's own width is 2 to 8 f64 lanes (2 where it names the CPU generic)
     assert wide["wide_in_advance"] > 100  # the RK4 step's products, each on 16 pendulums at once
     same = {k: v for k, v in narrow.items() if k not in ("width", "wide", "wide_in_advance", "drawn width")}
-    assert sorted(same) == ["advance", "drawn frame", "drawn rigid_chaos f32", "drawn rigid_chaos f64",
+    assert sorted(same) == ["advance", "drawn frame", "drawn ftle", "drawn rigid_chaos f32", "drawn rigid_chaos f64",
                             "drawn shrunk", "drawn triple_chaos f32", "drawn triple_chaos f64", "drawn yuv", "kernels",
                             "rigid_chaos f64"]
     assert same == {k: wide[k] for k in same}, "the width changed the numbers"
-    # 32 lanes (the width on a CPU LLVM calls generic): groups of 32 pendulums, the canvas's trails faded 32
-    # pixels at a time, the YUV conversion and the GIF's shrink 32 words at a time (vector_width.lanes)
-    wider = child("draw", 32, tmp_path)
-    assert wider["width"] == 32
-    assert {k[len("drawn "):]: v for k, v in same.items() if k.startswith("drawn ")} == \
-        {k: v for k, v in wider.items() if k != "width"}, "32 lanes changed the numbers"
+    # the other widths set on a CPU LLVM calls generic: 32 lanes, with groups of 32 pendulums, the canvas's trails
+    # faded 32 pixels at a time, the YUV conversion and the GIF's shrink 32 words at a time (vector_width.lanes),
+    # and the FTLE map's 8
+    drawn = {k[len("drawn "):]: v for k, v in same.items() if k.startswith("drawn ")}
+    for width in (8, 32):
+        other = child("draw", width, tmp_path)
+        assert other["width"] == width
+        assert drawn == {k: v for k, v in other.items() if k != "width"}, f"{width} lanes changed the numbers"
 
 
 def test_the_elf_symbol_table_gives_the_address_the_dynamic_linker_gives():

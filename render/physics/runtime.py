@@ -46,11 +46,11 @@ def serial(work: int) -> bool:
 
 
 def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, keep_log: bool = False,
-         lanes: int | None = None) -> str:
+         tangents: bool = False) -> str:
     """(Re)initialise Taichi if the settings differ; returns the arch actually in use. The log of kernels and
     fields starts afresh, unless keep_log and Taichi runs on as it was. Called by render/physics/stepper.py's
-    Run, which builds the system it is for: no caller has to start Taichi, or in which precision. lanes: the
-    most lanes its kernels take well (vector_width.apply), heeded by the process's first init only."""
+    Run, which builds the system it is for: no caller has to start Taichi, or in which precision. tangents: for
+    the FTLE map, whose kernels take fewer lanes well (vector_width.apply), heeded by the process's first init."""
     global _current, _generation
     want = (arch, precision, threads)
     if _current is not None and _current[0] == want:
@@ -67,7 +67,7 @@ def init(arch: str = "cpu", precision: str = "f64", threads: int | None = None, 
         kw["cpu_max_num_threads"] = threads
     writable_cache()
     if arch == "cpu":  # before the first kernel compiles: LLVM reads its options then
-        vector_width.apply(lanes)
+        vector_width.apply(tangents)
     # Never ti.gpu: it segfaults where there is no GPU. ti.cuda falls back to the CPU by itself.
     # ti.init prints "[Taichi] Starting on arch=..." to stdout unconditionally; stdout is for results.
     with contextlib.redirect_stdout(io.StringIO()), held_stderr.held(_unless_failed):

@@ -44,12 +44,11 @@ class Run:
                  precision: str | None = None, keep_log: bool = False, compensated: bool = False):
         # Taichi is imported with the first Run, not with this module: the certificate's and the quality
         # levels' modules import Run, and the run-time estimate reads their sizes without running anything.
-        from . import runtime, vector_width
+        from . import runtime
 
         self.scene = scene
-        # the FTLE map's tangents take fewer lanes well (vector_width.TANGENTS)
-        lanes = vector_width.TANGENTS if scene.fractal == "lyapunov" else None
-        self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log, lanes)  # in use
+        tangents = scene.fractal == "lyapunov"  # the FTLE map's kernels take fewer lanes well (vector_width)
+        self.arch = runtime.init(arch, precision or scene.integrator.precision, threads, keep_log, tangents)  # in use
         self.generation = runtime.generation()
         self.sim = build(scene, subset, precision, compensated)
 

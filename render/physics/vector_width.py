@@ -61,23 +61,26 @@ WIDTH = 16
 # 1.63-1.66 → 1.54 ms; the same states and frames (2-core AMD EPYC, 2026-12-07: docs/performance.md names the
 # commands). Not measured on the Intel CPUs of PREFER_256, which keep 16.
 WIDER = {"generic": 32}
-# But a kernel that carries tangent vectors (the FTLE map's 20 values a lane) spills its registers at 32 lanes: a
-# 720p frame's simulation took 144-151 ms against 121-123 at 16 (python benchmarks/map_frame.py fractal_lyapunov,
-# interleaved, 2-core AMD EPYC), so a process that starts with such a scene takes at most 16 (apply(most)).
-TANGENTS = 16
+# But the FTLE map's kernels carry four tangent vectors a pixel, 20 values a lane, and spill their registers when
+# wide. A 720p frame's simulation took 144-151 ms at 32 lanes against 121-123 at 16; then 114-117 ms at 8 in three
+# rounds of four (the other 253) against 123-137 at 16; a 1 s render of it at 720p 5.81-7.57 s at 8 against
+# 6.75-8.27 s at 16, the same bytes (python benchmarks/map_frame.py fractal_lyapunov --seconds 0.5, and pendulum
+# render, alternating; 2-core AMD EPYC). So a process that starts with an FTLE scene takes this width for its CPU
+# (apply(tangents=True)), else the CPU's own (WIDER, WIDTH).
+TANGENTS = {"generic": 8}
 ENV, WIDTHS = "PENDULUM_VECTOR_WIDTH", ("0", "1", "2", "4", "8", "16", "32", "64")  # LLVM takes powers of 2
 _SYM = np.dtype([("name", "<u4"), ("info", "u1"), ("other", "u1"), ("shndx", "<u2"), ("value", "<u8"),
                  ("size", "<u8")])
 _done: int | None = None  # the width this process set (0: none); LLVM's options are parsed once per process
 
 
-def apply(most: int | None = None) -> int:
+def apply(tangents: bool = False) -> int:
     """Set the loop vectoriser's width for this process, once, before any kernel compiles; returns the width
-    set, 0 where LLVM keeps its own. most: the most lanes the process's work takes well (TANGENTS), where the
-    width is the CPU's and not asked for. Also points Taichi's offline cache at the width's own subfolder."""
+    set, 0 where LLVM keeps its own. tangents: the process is for the FTLE map (TANGENTS), where the width is
+    the CPU's and not asked for. Also points Taichi's offline cache at the width's own subfolder."""
     global _done
     if _done is None:
-        width, parse = _plan(most)
+        width, parse = _plan(tangents)
         if width:
             argv = [b"pendulum", f"-force-vector-width={width}".encode()]
             parse(len(argv), (ctypes.c_char_p * len(argv))(*argv), b"")
@@ -87,15 +90,15 @@ def apply(most: int | None = None) -> int:
     return _done
 
 
-def planned(most: int | None = None) -> int:
-    """The width apply(most) sets, or set, in this process (0: LLVM's own), without setting it."""
-    return _done if _done is not None else _plan(most)[0]
+def planned(tangents: bool = False) -> int:
+    """The width apply(tangents) sets, or set, in this process (0: LLVM's own), without setting it."""
+    return _done if _done is not None else _plan(tangents)[0]
 
 
-def _plan(most: int | None = None):
+def _plan(tangents: bool = False):
     """(width, LLVMParseCommandLineOptions as a callable): the width PENDULUM_VECTOR_WIDTH asks for, else WIDTH
-    (or WIDER's for the CPU) where the CPU has AVX-512 and LLVM targets it as one of NARROW; (0, None) where it
-    is LLVM's own or cannot be set."""
+    (or WIDER's or TANGENTS' for the CPU) where the CPU has AVX-512 and LLVM targets it as one of NARROW;
+    (0, None) where it is LLVM's own or cannot be set."""
     asked = os.environ.get(ENV, "").strip()
     if asked and asked not in WIDTHS:
         raise SceneError(f"${ENV}: {asked!r} is not a width: one of {', '.join(WIDTHS)} (0: LLVM's own)")
@@ -106,8 +109,7 @@ def _plan(most: int | None = None):
     if llvm is None or not (asked or cpu in NARROW):
         return 0, None
     parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
-    width = int(asked) if asked else WIDER.get(cpu, WIDTH)
-    width = width if asked or not most else min(width, most)
+    width = int(asked) if asked else (TANGENTS if tangents else WIDER).get(cpu, WIDTH)
     return width, parse(llvm["LLVMParseCommandLineOptions"])
 
 

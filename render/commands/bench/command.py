@@ -86,7 +86,7 @@ def run(args) -> int:
     for name in FILES:  # a folder or an immutable file where one goes: refused now, not after minutes of bench
         check_replaceable(args.out / name)
     width = vector_width.planned()  # a bad $PENDULUM_VECTOR_WIDTH stops the bench here, not in its first phase
-    ftle = vector_width.planned(vector_width.TANGENTS)
+    ftle = vector_width.planned(tangents=True)
     load = os.getloadavg()  # other work on the machine skews every figure: the report says how much
     print(f"bench: load average {load_text(load)} at the start, {cpu_kind()} CPU, "
           f"{width_text({'vector_width': width, 'llvm_cpu': vector_width.llvm_cpu(), 'vector_width_ftle': ftle})}",

@@ -44,7 +44,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "machine": {"cpus": os.cpu_count(), "cpu": cpu_model(), "cpu_kind": kind,
                        "simd": vector_width.simd_flags(),
                        "vector_width": vector_width.planned(),  # the phases' processes set it so
-                       "vector_width_ftle": vector_width.planned(vector_width.TANGENTS),  # and the FTLE map's
+                       "vector_width_ftle": vector_width.planned(tangents=True),  # and the FTLE map's
                        "llvm_cpu": vector_width.llvm_cpu(),  # what Taichi's LLVM takes the CPU for
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
