@@ -225,22 +225,24 @@ def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tm
 
     from render.commands.bench import process
     from render.physics import vector_width
-    cache, runs = tmp_path / "cache", []
+    cache, ftle, runs = tmp_path / "cache", tmp_path / "cache-ftle", []  # the FTLE map's width may be another's
     cache.mkdir()
-    monkeypatch.setattr(vector_width, "cache_folder", lambda arch: str(cache))
+    ftle.mkdir()
+    monkeypatch.setattr(vector_width, "cache_folder", lambda arch, tangents=False: str(ftle if tangents else cache))
 
     def phase(name, args, tmp):  # the first run of each phase compiles two kernels, written at its exit
         runs.append(name)
         if runs.count(name) == 1:
             for k in range(2):
-                (cache / f"T{name}{k}.tic").write_bytes(b"")
+                (ftle if name == "fractal_lyapunov" else cache).joinpath(f"T{name}{k}.tic").write_bytes(b"")
         return {"wall_s": 20.0 - len(runs)}
     monkeypatch.setattr(process, "_run_phase", phase)
     full, quick = SimpleNamespace(quick=False, arch="cpu"), SimpleNamespace(quick=True, arch="cpu")
     assert process.run_phase("e2e", full, tmp_path) == {"wall_s": 18.0, "compiled": 2, "rerun": True}
     assert process.run_phase("e2e", full, tmp_path) == {"wall_s": 17.0, "compiled": 0, "rerun": False}
     assert process.run_phase("hud", quick, tmp_path) == {"wall_s": 16.0, "compiled": 2, "rerun": False}
-    assert runs == ["e2e", "e2e", "e2e", "hud"]
+    assert process.run_phase("fractal_lyapunov", full, tmp_path) == {"wall_s": 14.0, "compiled": 2, "rerun": True}
+    assert runs == ["e2e", "e2e", "e2e", "hud", "fractal_lyapunov", "fractal_lyapunov"]
     res = fake_results()
     assert "compile" not in report.markdown(report.summarise(res, True, 1.0, 2.0, [0.5] * 3))
     res["e2e"].update(compiled=2, rerun=True)

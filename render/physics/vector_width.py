@@ -250,8 +250,9 @@ def _in_cache(sub: str) -> str:
     return path if os.path.basename(os.path.normpath(path)) == sub else os.path.join(path, sub)
 
 
-def cache_folder(arch: str = "cpu") -> str:
-    """The folder Taichi's offline cache writes this process's kernels to, or a child's it starts on `arch`:
-    apply()'s subfolder where it sets a width (runtime.init applies it on the CPU only), else the cache itself."""
-    width = planned() if arch == "cpu" else 0
+def cache_folder(arch: str = "cpu", tangents: bool = False) -> str:
+    """The folder Taichi's offline cache writes this process's kernels to, or a child's it starts on `arch`
+    (tangents: for the FTLE map): apply()'s subfolder where it sets a width (runtime.init applies it on the CPU
+    only), else the cache itself."""
+    width = planned(tangents) if arch == "cpu" else 0
     return _in_cache(f"llvm-vf{width}") if width else cache_root()

@@ -31,12 +31,17 @@ def run_phase(name: str, args, tmp: Path) -> dict:
 
 
 def cached_kernels(arch: str) -> set[str]:
-    """The kernels in the offline cache the phases' processes on `arch` use (empty if it does not exist yet)."""
+    """The kernels in the offline cache folders the phases' processes on `arch` use: their width's, and the FTLE
+    map's where it takes another (empty where none exists yet). Counting the first alone, the FTLE phase's
+    compiles went unseen, and its timed render compiled: 4.03 s of simulation for 30 frames against 3.05."""
     from ...physics import vector_width
-    try:
-        return {f for f in os.listdir(vector_width.cache_folder(arch)) if f.endswith(".tic")}
-    except OSError:
-        return set()
+    found = set()
+    for folder in {vector_width.cache_folder(arch), vector_width.cache_folder(arch, tangents=True)}:
+        try:
+            found |= {os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".tic")}
+        except OSError:
+            pass
+    return found
 
 
 def _run_phase(name: str, args, tmp: Path) -> dict:
