@@ -33,7 +33,8 @@ def run_phase(name: str, args, tmp: Path) -> dict:
 def cached_kernels(arch: str) -> set[str]:
     """The kernels in the offline cache folders the phases' processes on `arch` use: their width's, and the FTLE
     map's where it takes another (empty where none exists yet). Counting the first alone, the FTLE phase's
-    compiles went unseen, and its timed render compiled: 4.03 s of simulation for 30 frames against 3.05."""
+    compiles went unseen, and its timed render compiled: 4.03 s of simulation for 30 frames, against 3.18 s with
+    them cached (runs D and E, docs/performance.md)."""
     from ...physics import vector_width
     found = set()
     for folder in {vector_width.cache_folder(arch), vector_width.cache_folder(arch, tangents=True)}:
