@@ -1,6 +1,6 @@
-"""render/physics/vector_width.py: LLVM's loop vectoriser at 16 or 32 lanes changes the code, never the numbers.
+"""render/physics/vector_width.py: LLVM's loop vectoriser at 8, 16 or 32 lanes changes the code, never the numbers.
 
-The width is set by hand here (PENDULUM_VECTOR_WIDTH), so both widths are checked on either CPU kind: on an
+The width is set by hand here (PENDULUM_VECTOR_WIDTH), so every width is checked on either CPU kind: on an
 AVX2 machine a 16-lane vector is 4 registers, on AVX-512 2.
 """
 import ctypes

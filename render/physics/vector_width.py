@@ -8,11 +8,12 @@ own command-line options live in Taichi's library, and `-force-vector-width=16` 
 16 lanes in every loop it vectorises: a group of 16 f64 pendulums (System.CHUNK) in two 512-bit registers a
 value, 32 f32 ones in two. benchmarks/vector_width.py measures what each width gives (docs/performance-log.md).
 A CPU with AVX-512 that LLVM 15 does not know (AMD's Zen 5) it names "generic", and there its own choice was
-slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW), and 32 faster again (WIDER). The loops
-sized for the vectoriser take lanes() columns, at least the width, so that a wider one is never left scalar.
+slower still: 16 lanes ran rigid RK4 5.4 times as fast in f64 (NARROW), 32 faster again (WIDER), and the FTLE
+map is quickest at 8 (TANGENTS). The loops sized for the vectoriser take lanes() columns, at least the width, so
+that a wider one is never left scalar.
 
 No arithmetic changes: fast_math is off, so no float reduction may be reassociated, and each lane computes
-what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frame at 0, 16 and 32 lanes).
+what it computed at 4 or 8 lanes (tests/test_vector_width.py: the same states and frames at 0, 8, 16 and 32 lanes).
 
 LLVM's C entry point LLVMParseCommandLineOptions is in the library but not exported, so it is looked up in the
 library's ELF symbol table and called at its address. Where that cannot be done (no symbol table, another
@@ -50,9 +51,9 @@ PREFER_256 = frozenset({"skylake-avx512", "cascadelake", "cooperlake", "cannonla
 # 38 to 207 M steps/s in f64 and 90 to 261 M in f32, the same states (`python benchmarks/vector_width.py
 # --widths 0 8 16 --rounds 2`, 2-core AMD EPYC, 2026-12-07; 8 lanes: 154 and 179 M).
 NARROW = PREFER_256 | {"generic"}  # where a width is set unless PENDULUM_VECTOR_WIDTH says otherwise
-# Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64;
-# 32 is more in f32 but leaves a 16-lane f64 loop to its scalar remainder (23M against 128M steps/s), and the
-# option is one for every loop of the process.
+# Lanes: a group's 16 f64 values in 2 zmm registers, its 32 f32 ones in two passes of one. 8 gave less in f64.
+# 32 was measured on the Xeon only before lanes() sized the loops to the width, when it left a 16-lane f64 loop
+# to its scalar remainder (23M against 128M steps/s); it has not been measured there since.
 WIDTH = 16
 # Where LLVM names the CPU "generic" (Zen 5), 32 lanes, and every loop sized for the vectoriser takes at least
 # that many columns (lanes()), so none is left to its scalar remainder. From 16 to 32 lanes, alternating: rigid
@@ -105,8 +106,10 @@ def _plan(tangents: bool = False):
     if asked == "0" or not (asked or "avx512f" in simd_flags()):  # no AVX-512: nothing to look up
         return 0, None
     llvm = _llvm()
-    cpu = None if llvm is None else _host_cpu(llvm)
-    if llvm is None or not (asked or cpu in NARROW):
+    if llvm is None:
+        return 0, None
+    cpu = _host_cpu(llvm)
+    if not (asked or cpu in NARROW):
         return 0, None
     parse = ctypes.CFUNCTYPE(None, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_char_p)
     width = int(asked) if asked else (TANGENTS if tangents else WIDER).get(cpu, WIDTH)
