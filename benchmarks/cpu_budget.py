@@ -2,9 +2,9 @@
 
     .venv/bin/python benchmarks/cpu_budget.py [--rounds 3] [--seconds 20]
 
-Runs what `pendulum bench` times for end_to_end_over_encode_floor, rigid_chaos's render and its encode floor
-(render/commands/bench/command.py's phase_encode, and pipeline.render as its timed_render runs it, after a one-frame
-warm-up render), alternating, once a round. For each it prints the wall time, this process's CPU time, its
+Runs what `pendulum bench` times for end_to_end_over_encode_floor, as its e2e phase does
+(render/commands/bench/e2e.py): rigid_chaos's frames recorded once, then its encode floor and its render (after a
+one-frame warm-up render), alternating, once a round. For each it prints the wall time, this process's CPU time, its
 ffmpeg children's CPU time (they are waited for inside the span), and the cores' idle time over the span (from
 /proc/stat: the whole machine's, so run it on a quiet one). The floor's span is its Encoder's, from its creation
 to the end of close(), as the bench times it; recording the floor's frames beforehand is not in it.
@@ -26,8 +26,8 @@ from pathlib import Path
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from render.commands.bench import command as bench  # noqa: E402
-from render.video import encode, pipeline  # noqa: E402
+from render.commands.bench import e2e  # noqa: E402
+from render.video import pipeline  # noqa: E402
 
 
 def usage() -> tuple[float, float, float, float]:
@@ -44,26 +44,12 @@ def spent(a, b) -> dict:
     return {"wall": wall, "ours": ours, "ffmpeg": ffmpeg, "idle": idle}
 
 
-def floor(cfg: dict, tmp: Path) -> dict:
-    """One encode floor as phase_encode times it: from its Encoder's creation to the end of its close()."""
-    marks = {}
-    made, closed = encode.Encoder.__init__, encode.Encoder.close
-
-    def init(self, *a, **k):
-        marks["start"] = usage()
-        made(self, *a, **k)
-
-    def close(self, *a, **k):
-        sizes = closed(self, *a, **k)
-        marks["end"] = usage()
-        return sizes
-
-    encode.Encoder.__init__, encode.Encoder.close = init, close
-    try:
-        bench.phase_encode({**cfg, "rounds": 1}, "cpu", tmp)
-    finally:
-        encode.Encoder.__init__, encode.Encoder.close = made, closed
-    return spent(marks["start"], marks["end"])
+def floor(rec: dict, tmp: Path) -> dict:
+    """One encode floor as the bench times it (e2e.encode_floor: from its Encoder's creation to the end of its
+    close())."""
+    start = usage()
+    e2e.encode_floor(rec, tmp)
+    return spent(start, usage())
 
 
 def render(scene, tmp: Path) -> dict:
@@ -78,14 +64,15 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=20.0, help="rigid_chaos's duration (the bench's: 20)")
     args = ap.parse_args(argv)
     cfg = {"chaos_s": args.seconds}
-    scene = bench.chaos_scene(cfg)
+    scene = e2e.chaos_scene(cfg)
     cores = os.cpu_count()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        rec = e2e.record_frames(cfg, "cpu", tmp)
         pipeline.render(scene.replace(video={"duration": 1.0 / scene.video.fps}), tmp / "warm")
         rows = []
         for r in range(args.rounds):
-            rows += [("floor", r, floor(cfg, tmp)), ("render", r, render(scene, tmp))]
+            rows += [("floor", r, floor(rec, tmp)), ("render", r, render(scene, tmp))]
     print(f"rigid_chaos, {args.seconds:g} s; seconds of wall, of CPU (ours, ffmpeg's) and of idle cores ({cores}):")
     for name, r, s in rows:
         print(f"  {name:6s} round {r + 1}: wall {s['wall']:5.2f}  ours {s['ours']:5.2f}  ffmpeg {s['ffmpeg']:5.2f}  "

@@ -163,10 +163,11 @@ def fake_results(numba=True):
                "timings": {"certify": 0.1, "simulate": 1.0, "draw": 0.5, "encode": 0.2},
                "integrator": {"method": "rk4", "dt": 2e-3, "substeps": 9, "precision": "f64"},
                "map": {"plot": {"width": 640}, "events": 3, "events_trusted": 3}}
-    res = {"sim": {"rows": rows, "peak": pk}, "encode": {"draw_fps": 200.0, "sim_draw_fps": 180.0, "floor_s": 1.0,
-                                                         "floor_rounds_s": [0.9, 1.1], "encode_fps": 120.0},
+    res = {"sim": {"rows": rows, "peak": pk},
            "e2e": {"wall_s": 1.2, "rounds_s": [1.3, 1.1], "frames": 120,
-                   "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4}, "fixed_s": 0.3},
+                   "timings": {"simulate": 0.1, "draw": 0.6, "encode": 0.4}, "fixed_s": 0.3,
+                   "draw_fps": 200.0, "sim_draw_fps": 180.0, "floor_s": 1.0, "floor_rounds_s": [0.9, 1.1],
+                   "encode_fps": 120.0},
            "hud": {"frames": 118, "ms": 0.8, "rounds_ms": [0.9, 0.8], "spread": peers.spread([0.9, 0.8], 0.8),
                    "size": "1280x720"}, "matplotlib": mpl,
            "rainbow": {"frames": 178, "draw_fps": 40.0, "sim_fps": 300.0, "size": "1280x720", "effects": ["rods"]},
@@ -215,6 +216,36 @@ def test_report_without_numba_has_null_peer_ratios_and_spreads(monkeypatch):
         assert rep[key] is None and rep["spread"][key] is None
     assert rep["targets"]["sim_speedup_vs_numba_1e5"]["met"] is None
     assert "null" in report.markdown(rep)
+
+
+def test_the_e2e_phase_alternates_the_floor_and_the_render(monkeypatch, tmp_path):
+    """Round i's floor, then round i's render (the first after a one-frame warm-up), in one process: the ratio's
+    rounds pair times taken seconds apart, and its median is the medians' ratio (render/commands/bench/e2e.py)."""
+    from render.commands.bench import e2e
+    calls, walls = [], iter([7.0, 7.5, 6.9, 0.8])  # three rounds' renders, then the one-frame render
+    floors = iter([6.2, 6.0, 6.4])
+    raw = tmp_path / "frames.raw", tmp_path / "gif.raw"
+    for path in raw:
+        path.write_bytes(b"")
+    monkeypatch.setattr(e2e, "record_frames", lambda cfg, arch, tmp: {"draw_fps": 300.0, "sim_draw_fps": 280.0,
+                                                                       "files": raw})
+
+    def floor(rec, tmp):
+        calls.append("floor")
+        return next(floors)
+
+    def render(scene, arch, tmp, warm=None):
+        calls.append(f"render {scene.frames}" + (f" after {warm.frames}" if warm is not None else ""))
+        return next(walls), {"frames": scene.frames, "timings_s": {"draw": 1.0}}
+    monkeypatch.setattr(e2e, "encode_floor", floor)
+    monkeypatch.setattr(e2e, "timed_render", render)
+    out = e2e.phase_e2e({**command.QUICK, "chaos_s": 2.0, "rounds": 3}, "cpu", tmp_path)
+    assert calls == ["floor", "render 120 after 1", "floor", "render 120", "floor", "render 120", "render 1"]
+    assert out["rounds_s"] == [7.0, 7.5, 6.9] and out["floor_rounds_s"] == [6.2, 6.0, 6.4]
+    assert (out["wall_s"], out["floor_s"], out["fixed_s"]) == (7.0, 6.2, 0.8)
+    assert out["encode_fps"] == pytest.approx(120 / 6.2) and not any(path.exists() for path in raw)
+    spread = peers.ratio(out["rounds_s"], out["floor_rounds_s"])
+    assert spread["value"] == pytest.approx(7.0 / 6.2) and spread["max"] == pytest.approx(7.5 / 6.0)
 
 
 def test_a_phase_that_compiled_runs_again_and_the_report_says_so(monkeypatch, tmp_path):

@@ -325,7 +325,7 @@ def test_benchs_rates_reproduce_what_it_measured(tmp_path):
     rows = [{"system": s, "precision": p, "n": n, "taichi": rate * (1 + n / 1e6)}
             for (s, p), rate in {("rigid", "f64"): 3e7, ("rigid", "f32"): 5e7, ("elastic", "f64"): 9e7,
                                  ("elastic", "f32"): 2e8}.items() for n in (100, 10 ** 5, 10 ** 6)]
-    res = {"sim": {"rows": rows}, "encode": {"draw_fps": 80.0, "encode_fps": 50.0}, "e2e": {"fixed_s": 4.0}}
+    res = {"sim": {"rows": rows}, "e2e": {"draw_fps": 80.0, "encode_fps": 50.0, "fixed_s": 4.0}}
     rates = estimate.measured(res, chaos)
     assert rates["steps_per_s"]["rigid_f64"] == 3e7 * 1.1 and rates["fixed_s"] == 4.0  # N = 1e5, not 1e6
     assert rates["steps_per_s"]["triple_f64"] == pytest.approx(RATES["steps_per_s"]["triple_f64"] * 3.3e7 / 2.5e7)

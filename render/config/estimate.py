@@ -236,7 +236,7 @@ def picture_frame_s(scene, rates: dict, panels: int = 0) -> tuple[float, float]:
 def measured(res: dict, chaos) -> dict:
     """rates.json from `pendulum bench`'s phases (`res`, render/commands/bench/command.py): the RK4 rates at the largest N
     measured up to 1e5, the triple's scaled as the rigid system's (not benched); the drawing and encoding
-    constants scaled so that the model gives the measured fps of `chaos` (the scene the encode phase drew);
+    constants scaled so that the model gives the measured fps of `chaos` (the scene the e2e phase drew);
     the fixed cost of a one-frame render."""
     rates = json.loads(json.dumps(RATES))
     rows = [r for r in res["sim"]["rows"] if r["n"] <= 10 ** 5]
@@ -247,9 +247,9 @@ def measured(res: dict, chaos) -> dict:
                                                   [f"rigid_{prec}"] / RATES["steps_per_s"][f"rigid_{prec}"])
     draw_only = {**RATES, "mp4_frame_s": 0, "mp4_pixel_s": 0, "gif_frame_s": 0, "gif_pixel_s": 0}
     encode_only = {**RATES, "draw_frame_s": 0, "draw_pixel_s": 0, "draw_link_s": 0, "hud_frame_s": 0}
-    for keys, fps, model in ((("draw_frame_s", "draw_pixel_s", "draw_link_s", "hud_frame_s"), res["encode"]["draw_fps"],
+    for keys, fps, model in ((("draw_frame_s", "draw_pixel_s", "draw_link_s", "hud_frame_s"), res["e2e"]["draw_fps"],
                               draw_only),
-                             (("mp4_frame_s", "mp4_pixel_s", "gif_frame_s", "gif_pixel_s"), res["encode"]["encode_fps"],
+                             (("mp4_frame_s", "mp4_pixel_s", "gif_frame_s", "gif_pixel_s"), res["e2e"]["encode_fps"],
                               encode_only)):
         scale = (1.0 / fps) / picture_frame_s(chaos, model)[0]
         for k in keys:

@@ -23,6 +23,7 @@ import numpy as np
 
 from ...config import estimate
 from . import peers
+from .e2e import CHAOS, chaos_scene, phase_e2e, timed_render
 from .process import maxrss_mb, run_phase
 from .sim import phase_sim
 from .report import cpu_kind, fmt, load_text, markdown, summarise, targets_table, width_text
@@ -30,7 +31,7 @@ from ...video.atomic import together, write_atomic
 from ...config.options import check_replaceable, check_writable, out_path, positive_int
 from ...physics import vector_width
 
-CHAOS, RAINBOW = "rigid_chaos", "rainbow_1000"
+RAINBOW = "rainbow_1000"
 FRACTALS = {"angles": "fractal", "flip_time": "fractal_flip", "divergence": "fractal_divergence",
             "lyapunov": "fractal_lyapunov"}  # colouring: preset (each measured at 720p: SIZE)
 SIZE = ["video.width=1280", "video.height=720"]
@@ -120,85 +121,6 @@ def run(args) -> int:
 
 # ---------------------------------------------------------------- phases
 
-def chaos_scene(cfg):
-    from ...config.scene import load
-    return load(CHAOS, [f"video.duration={cfg['chaos_s']}"])
-
-
-def phase_encode(cfg, arch, tmp) -> dict:
-    """Record rigid_chaos's frames as a render makes them (pipeline.Source, and the GIF's own smaller frames
-    from gif.Frames), timing simulate and draw, then time only the encoding of those frames (memory-mapped)
-    through the same Encoder: the floor an end-to-end render cannot beat. Until 2026-12-04 the floor fed the GIF
-    the video's frames, which the Encoder then area-averaged in numpy (3.1 s of this process's CPU beside the
-    encoders on the 2-core Xeon): work no render does, so the floor was higher than the encoders alone."""
-    from ...video import pipeline
-    from ...video.encode import Encoder
-    from ...video.gif import Frames
-
-    scene = chaos_scene(cfg)
-    src = pipeline.Source(scene, arch)
-    scene, v = src.scene, src.scene.video
-    small = Frames(src, v, {"draw": 0.0}) if "gif" in v.formats else None
-    raw, raw_small, kept, draw, simulate = tmp / "frames.raw", tmp / "gif.raw", [], 0.0, 0.0
-    with open(raw, "wb") as fh, open(raw_small, "wb") as fs:
-        for f in range(scene.frames):
-            if f == 2:  # frames 0 and 1 instantiate the kernels; time the steady state
-                draw, simulate = 0.0, src.timings["simulate"]
-            d0 = src.timings["draw"]
-            frame = src.next_frame()
-            draw += src.timings["draw"] - d0
-            fh.write(memoryview(frame).cast("B"))
-            gif_frame = small.frame(f, frame) if small else None
-            if gif_frame is not None:
-                kept.append(f)
-                fs.write(memoryview(np.ascontiguousarray(gif_frame)).cast("B"))
-    simulate = src.timings["simulate"] - simulate
-    n = scene.frames - 2
-    frames = np.memmap(raw, np.uint8, "r", shape=(scene.frames, v.height, v.width, 3))
-    gif_frames = None
-    if kept:
-        gw, gh = small.w, small.h
-        gif_frames = dict(zip(kept, np.memmap(raw_small, np.uint8, "r", shape=(len(kept), gh, gw, 3))))
-    (tmp / "floor").mkdir(exist_ok=True)
-    floors = []  # one encode per round, as phase_e2e renders once per round
-    for _ in range(cfg["rounds"]):
-        t = time.perf_counter()
-        enc = Encoder(tmp / "floor", scene.name, v, scene.frames, planar=True)
-        for f in range(scene.frames):
-            enc.write(frames[f], gif_frames.get(f) if gif_frames else None)
-        enc.close()
-        floors.append(time.perf_counter() - t)
-    del frames, gif_frames
-    raw.unlink()
-    raw_small.unlink()
-    floor = statistics.median(floors)
-    return {"draw_fps": n / draw, "sim_draw_fps": n / (draw + simulate), "floor_s": floor, "floor_rounds_s": floors,
-            "encode_fps": scene.frames / floor}
-
-
-def timed_render(scene, arch, tmp, warm_scene=None) -> tuple[float, dict]:
-    """Wall time of pipeline.render, after a warm-up render (Taichi init, kernel cache); and its metadata."""
-    from ...video import pipeline
-    if warm_scene is not None:
-        pipeline.render(warm_scene, tmp / "warm", arch=arch)
-    t = time.perf_counter()
-    meta = pipeline.render(scene, tmp / "timed", arch=arch)
-    return time.perf_counter() - t, meta
-
-
-def phase_e2e(cfg, arch, tmp) -> dict:
-    """rigid_chaos rendered once per round (--repeat), the first after a one-frame warm-up render: the median
-    wall time, each round's, and the median render's split; then a one-frame render, the fixed cost."""
-    scene = chaos_scene(cfg)
-    one = scene.replace(video={"duration": 1.0 / scene.video.fps})
-    runs = [timed_render(scene, arch, tmp, one if r == 0 else None) for r in range(cfg["rounds"])]
-    walls = [wall for wall, _ in runs]
-    _, meta = sorted(runs, key=lambda run: run[0])[(len(runs) - 1) // 2]  # the median's split (the lower of two)
-    fixed, _ = timed_render(one, arch, tmp)  # what every render pays besides its frames
-    return {"wall_s": statistics.median(walls), "rounds_s": walls, "frames": meta["frames"],
-            "timings": meta["timings_s"], "fixed_s": fixed}
-
-
 def phase_fractal(colouring, cfg, arch, tmp) -> dict:
     """One map preset rendered at 720p as it ships (its accurate step, MP4 + GIF + PNG); fps = frames / wall,
     the certificate included. The full bench renders its first frame before, at the same size, so that the
@@ -217,7 +139,7 @@ def phase_fractal(colouring, cfg, arch, tmp) -> dict:
 
 def phase_rainbow(cfg, arch, tmp) -> dict:
     """Drawing fps of rainbow_1000 (1000 pendulums, glow, 720p) over its whole video, the spray included (the
-    quick run: its first 3 s, still coherent), timed per frame like the encode phase: frames 0 and 1
+    quick run: its first 3 s, still coherent), timed per frame like the e2e phase's recording: frames 0 and 1
     instantiate kernels."""
     from ...physics.stepper import Run
     from ...draw.canvas import Canvas
@@ -318,5 +240,5 @@ def phase_matplotlib(cfg, arch, tmp) -> dict:
                    "draw": peers.ratio(runs["ours_draw"], runs["matplotlib_draw"])}}
 
 
-PHASES = {"sim": phase_sim, "encode": phase_encode, "e2e": phase_e2e, "hud": phase_hud, "rainbow": phase_rainbow,
+PHASES = {"sim": phase_sim, "e2e": phase_e2e, "hud": phase_hud, "rainbow": phase_rainbow,
           **{f"fractal_{c}": functools.partial(phase_fractal, c) for c in FRACTALS}, "matplotlib": phase_matplotlib}

@@ -19,7 +19,7 @@ def run_phase(name: str, args, tmp: Path) -> dict:
     how many kernels it compiled (Taichi's offline cache gained a file: it writes them when the process ends).
     Then, unless --quick (a smoke run), the phase runs once more and that run is kept (`rerun`): its warm-ups
     cannot load what the timed part compiles, since a kernel's cache key holds every field made before it in
-    the process (render/commands/bench/command.py's e2e phase)."""
+    the process (render/commands/bench/e2e.py)."""
     before = cached_kernels(args.arch)
     out = _run_phase(name, args, tmp)
     compiled = len(cached_kernels(args.arch) - before)

@@ -35,7 +35,7 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
 
     at = {f"{r['system']}_{r['precision']}": r["speedup"] for r in res["sim"]["rows"] if r["n"] == 10**5}
     headline = f"{res['sim']['rows'][0]['system']}_f64"
-    enc, e2e, rb = res["encode"], res["e2e"], res["rainbow"]
+    e2e, rb = res["e2e"], res["rainbow"]  # the render and its encode floor, alternating (e2e.py)
     fr = {k.removeprefix("fractal_"): v for k, v in res.items() if k.startswith("fractal_")}  # per colouring
     rows, mpl, pk = res["sim"]["rows"], res["matplotlib"], res["sim"]["peak"]
     kind = cpu_kind()
@@ -48,14 +48,14 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
                        "llvm_cpu": vector_width.llvm_cpu(),  # what Taichi's LLVM takes the CPU for
                        "python": platform.python_version(), "numpy": np.__version__, "ffmpeg": ffmpeg_version(),
                        "load_avg": list(load_at_start), "load_avg_end": list(os.getloadavg())},
-           "end_to_end_over_encode_floor": e2e["wall_s"] / enc["floor_s"],
+           "end_to_end_over_encode_floor": e2e["wall_s"] / e2e["floor_s"],
            "sim_speedup_vs_numpy_1e5": at[headline], "sim_speedup_vs_numpy_1e5_by_case": at,  # f64: presets'
            "fractal_fps": {c: r["fps"] for c, r in fr.items()},  # docs/performance.md: one per colouring
            "fractal_peak_mem_mb": max(r["peak_mem_mb"] for r in fr.values()),
            "rainbow_1000_draw_fps": rb["draw_fps"], "rainbow_1000": rb,
-           "draw_fps": enc["draw_fps"], "sim_draw_fps": enc["sim_draw_fps"], "encode_fps": enc["encode_fps"],
-           "end_to_end_s": e2e["wall_s"], "encode_floor_s": enc["floor_s"], "frames": e2e["frames"],
-           "end_to_end_rounds_s": e2e["rounds_s"], "encode_floor_rounds_s": enc["floor_rounds_s"],
+           "draw_fps": e2e["draw_fps"], "sim_draw_fps": e2e["sim_draw_fps"], "encode_fps": e2e["encode_fps"],
+           "end_to_end_s": e2e["wall_s"], "encode_floor_s": e2e["floor_s"], "frames": e2e["frames"],
+           "end_to_end_rounds_s": e2e["rounds_s"], "encode_floor_rounds_s": e2e["floor_rounds_s"],
            "end_to_end_fixed_s": e2e["fixed_s"], "end_to_end_timings": e2e["timings"], "fractal": fr,
            "sim": res["sim"]["rows"], "peak_mem_mb": {k: v["peak_mem_mb"] for k, v in res.items()}, "targets": {},
            **peers.throughput_keys(rows, e2e["wall_s"], chaos_s, mpl),
@@ -65,9 +65,9 @@ def summarise(res: dict, quick: bool, wall: float, chaos_s: float, load_at_start
            "rigid_rk4_peak_fraction": {p: v["fraction"]["value"] for p, v in pk.items()}, "peak": pk,
            "spread": {**peers.spreads(rows, mpl), **{f"rigid_rk4_peak_fraction.{p}": v["fraction"]
                                                      for p, v in pk.items()},
-                      # a render and a floor per round, in phases of their own: round i's render over its floor
+                      # a floor and a render per round, alternating: round i's render over its floor
                       "render_over_realtime": peers.ratio(e2e["rounds_s"], [chaos_s] * len(e2e["rounds_s"])),
-                      "end_to_end_over_encode_floor": peers.ratio(e2e["rounds_s"], enc["floor_rounds_s"]),
+                      "end_to_end_over_encode_floor": peers.ratio(e2e["rounds_s"], e2e["floor_rounds_s"]),
                       "hud_ms_720p": res["hud"].get("spread")},
            "peers": {"numba": peers.numba.__version__ if peers.numba else peers.MISSING},
            "compiled": {k: v["compiled"] for k, v in res.items() if v.get("compiled")},  # kernels, by phase
@@ -214,6 +214,6 @@ def markdown(r: dict) -> str:
     rounds = f"; its {len(h['rounds_ms'])} rounds' medians {spread_text(h['spread'])}" if h.get("spread") else ""
     out += ["", f"HUD alone at {h['size']}: **{h['ms']:.2f} ms** per frame (median of {h['frames']} frames{rounds})."]
     out += ["", "## Peak memory per phase (process tree)", ""]
-    out += table(["phase", "MB"], [[k + (" (includes the memory-mapped raw frames)" if k == "encode" else ""),
+    out += table(["phase", "MB"], [[k + (" (includes the memory-mapped raw frames)" if k == "e2e" else ""),
                                     f"{v:.0f}"] for k, v in r["peak_mem_mb"].items()])
     return "\n".join(out) + "\n"
