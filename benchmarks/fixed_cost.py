@@ -6,12 +6,14 @@
 render builds its canvases, HUD and system afresh, so Taichi's front end turns their kernels into IR again
 (render/physics/frontend.py) and each kernel's first launch loads it from the offline cache. Printed per render:
 its wall time, the time in Taichi's Kernel.materialize (the front end) and in the kernels' first launches
-through Taichi (loading, then running once). The first render also pays Taichi's start. Run it twice: the first
-run of a process history compiles what the cache lacks.
+through Taichi (loading, then running once), and the process's peak resident memory. The first render also pays
+Taichi's start. Run it twice: the first run of a process history compiles what the cache lacks (with --renders 8,
+every render from the fifth on, the first time: docs/performance-log.md, the twentieth session).
 """
 import argparse
 import collections
 import os
+import resource
 import sys
 import tempfile
 import time
@@ -53,7 +55,8 @@ def main(argv=None) -> int:
             t = time.perf_counter()
             pipeline.render(one, Path(tmp))
             print(f"render {r}: {time.perf_counter() - t:.3f} s, front end {spent['front end']:.3f} s, "
-                  f"first launches {spent['first launches']:.3f} s", flush=True)
+                  f"first launches {spent['first launches']:.3f} s, peak memory "
+                  f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB", flush=True)
     return 0
 
 
